@@ -1,0 +1,111 @@
+"""One results model for every grading run (an exercise or a quiz).
+
+Scores are exact (``Fraction``), so 7 of 10 passes a 70% mark with no float error.
+Renderers are pure functions of a :class:`RunResult`; see ``autograder.render``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from fractions import Fraction
+from typing import Any, Literal
+
+Status = Literal["passed", "failed", "error", "skipped"]
+Visibility = Literal["visible", "hidden", "after_published"]
+Kind = Literal["exercise", "quiz"]
+
+DEFAULT_PASS_MARK = Fraction(7, 10)
+
+
+def exact(value: float | int | str | Fraction) -> Fraction:
+    """A score as an exact fraction; floats go through their shortest decimal text."""
+    if isinstance(value, float):
+        return Fraction(repr(value))
+    return Fraction(value)
+
+
+def number(value: Fraction) -> int | float:
+    """A Fraction as a JSON number: whole numbers stay ints."""
+    return int(value) if value.denominator == 1 else round(float(value), 4)
+
+
+@dataclasses.dataclass(frozen=True)
+class TestResult:
+    """The outcome of one test (or one quiz question)."""
+
+    name: str
+    label: str
+    score: Fraction
+    max_score: Fraction
+    status: Status
+    message: str = ""
+    hint: str = ""
+    visibility: Visibility = "visible"
+    details: str = ""
+    data: dict[str, Any] = dataclasses.field(default_factory=dict)
+
+    @property
+    def passed(self) -> bool:
+        return self.status == "passed"
+
+
+@dataclasses.dataclass(frozen=True)
+class RunResult:
+    """A whole grading run: what every renderer is a pure function of."""
+
+    kind: Kind
+    id: str
+    title: str
+    tests: tuple[TestResult, ...]
+    pass_mark: Fraction = DEFAULT_PASS_MARK
+    lang: str = "en"
+    grader_error: str | None = None
+    grader_details: str = ""
+    log_tail: str = ""
+    execution_time: float = 0.0
+    data: dict[str, Any] = dataclasses.field(default_factory=dict)
+
+    @property
+    def score(self) -> Fraction:
+        return sum((t.score for t in self.tests), Fraction(0))
+
+    @property
+    def max_score(self) -> Fraction:
+        return sum((t.max_score for t in self.tests), Fraction(0))
+
+    @property
+    def fraction(self) -> Fraction:
+        return self.score / self.max_score if self.max_score else Fraction(0)
+
+    @property
+    def passed(self) -> bool:
+        """At or above the pass mark, compared exactly; never when the grader failed."""
+        return self.grader_error is None and self.max_score > 0 and \
+            self.fraction >= self.pass_mark
+
+    def to_dict(self) -> dict[str, Any]:
+        """Our JSON results shape (``--results``)."""
+        return {
+            self.kind: self.id,
+            "title": self.title,
+            "score": number(self.score),
+            "max_score": number(self.max_score),
+            "passed": self.passed,
+            "pass_mark": number(self.pass_mark),
+            "lang": self.lang,
+            "grader_error": self.grader_error,
+            "execution_time": round(self.execution_time, 3),
+            "tests": [
+                {
+                    "name": t.name,
+                    "label": t.label,
+                    "score": number(t.score),
+                    "max_score": number(t.max_score),
+                    "status": t.status,
+                    "message": t.message,
+                    "hint": t.hint,
+                    "visibility": t.visibility,
+                }
+                for t in self.tests
+            ],
+        }
