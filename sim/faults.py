@@ -1,0 +1,113 @@
+"""Fault injection: corrupted, malformed or missing scans, and obstacles that appear.
+
+Faults come from the world file's ``faults:`` list or are added at run time; each is a
+:class:`sim.worldfile.Fault` active over ``[start, end)`` in sim time.  Faults that pick
+beams draw them from a generator seeded by (world seed, fault index, scan time), so a run
+is reproducible whatever the order or pace of the calls.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from sim.lidar import Lidar
+from sim.worldfile import Box, Circle, Fault
+
+FAULT_KINDS = ("nan", "inf", "neg_inf", "below_min", "above_max", "empty", "wrong_length",
+               "dropout", "obstacle")
+_BEAM_VALUES = {"nan": np.nan, "inf": np.inf, "neg_inf": -np.inf}
+
+
+@dataclass(frozen=True)
+class Scan:
+    """What goes out on /scan: ranges may be shorter than the beam count on purpose."""
+
+    t: float
+    ranges: np.ndarray
+    intensities: np.ndarray
+
+
+def nan_readings(start: float, end: float | None = None, fraction: float = 0.1) -> Fault:
+    """A share of beams reads NaN over [start, end)."""
+    return Fault(kind="nan", start=start, end=end, fraction=fraction)
+
+
+def obstacle_at(start: float, obstacle: Box | Circle) -> Fault:
+    """``obstacle`` appears at sim time ``start``."""
+    if isinstance(obstacle, Box):
+        return Fault(kind="obstacle", start=start, box=obstacle)
+    return Fault(kind="obstacle", start=start, circle=obstacle)
+
+
+def _active(fault: Fault, t: float) -> bool:
+    return fault.start <= t and (fault.end is None or t < fault.end)
+
+
+class FaultInjector:
+    """Applies a list of faults to scans and tells when obstacles are due."""
+
+    def __init__(self, faults: tuple[Fault, ...] | list[Fault] = (), seed: int = 0,
+                 lidar: Lidar | None = None) -> None:
+        self.faults: list[Fault] = list(faults)
+        self.seed = seed
+        self.lidar = lidar or Lidar()
+        self._placed: set[int] = set()
+
+    def add(self, fault: Fault) -> None:
+        """Add a fault at run time (it takes effect from its ``start``)."""
+        if fault.kind not in FAULT_KINDS:
+            raise ValueError(f"unknown fault kind {fault.kind!r}")
+        self.faults.append(fault)
+
+    def reset(self) -> None:
+        """Forget which obstacles were placed (the world was rebuilt)."""
+        self._placed.clear()
+
+    def due_obstacles(self, t: float) -> list[Box | Circle]:
+        """Obstacles whose time has come and that were not placed yet."""
+        due: list[Box | Circle] = []
+        for i, fault in enumerate(self.faults):
+            if fault.kind == "obstacle" and i not in self._placed and fault.start <= t:
+                self._placed.add(i)
+                obstacle = fault.box or fault.circle
+                if obstacle is not None:
+                    due.append(obstacle)
+        return due
+
+    def dropout(self, t: float) -> bool:
+        """True while the sensor publishes nothing at all."""
+        return any(f.kind == "dropout" and _active(f, t) for f in self.faults)
+
+    def apply(self, t: float, ranges: np.ndarray) -> Scan | None:
+        """The scan to publish at ``t`` from clean ``ranges``, or None during a dropout."""
+        if self.dropout(t):
+            return None
+        ranges = ranges.astype(np.float32)
+        beams, length = len(ranges), len(ranges)
+        for i, fault in enumerate(self.faults):
+            if not _active(fault, t):
+                continue
+            if fault.kind in _BEAM_VALUES or fault.kind in ("below_min", "above_max"):
+                ranges[self._pick(i, t, beams, fault.fraction)] = self._value(fault.kind)
+            elif fault.kind == "wrong_length" and length:
+                # Never the right length by accident: the point is the disagreement.
+                length = fault.length if fault.length != beams else beams - 1
+            elif fault.kind == "empty":
+                length = 0
+        if length != beams:
+            ranges = np.resize(ranges, length)  # repeats readings when asked for more
+        return Scan(t, ranges, np.full(length, 100.0, dtype=np.float32))
+
+    def _value(self, kind: str) -> float:
+        if kind == "below_min":
+            return self.lidar.range_min / 2
+        if kind == "above_max":
+            return self.lidar.range_max + 1.0
+        return _BEAM_VALUES[kind]
+
+    def _pick(self, index: int, t: float, beams: int, fraction: float) -> np.ndarray:
+        rng = np.random.default_rng([self.seed, index, round(t * 1e6)])
+        count = round(beams * fraction)
+        return rng.choice(beams, size=count, replace=False)

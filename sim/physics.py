@@ -1,0 +1,217 @@
+"""Headless pymunk physics of the arena and the differential-drive robot.
+
+The robot is a dynamic disc steered like pymunk's "tank" example: a kinematic control
+body carries the commanded velocities, and a PivotJoint and a GearJoint with limited
+force drag the robot along.  Contacts with walls and obstacles are therefore solved by
+pymunk, not faked: a robot driven into a wall stops at it.  Time advances only in whole
+steps of ``dt`` and ``time`` is ``steps * dt``, so the same spec and command sequence give
+the same trajectory bit for bit.  Nothing here knows about ROS.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import pymunk
+
+from sim.worldfile import ROBOT_RADIUS, Box, Circle, WorldSpec
+
+ROBOT_MASS = 1.0
+"""kg, about a TurtleBot3 Burger."""
+_DRIVE_FORCE = 40.0
+"""N the drive may exert: enough for the acceleration limits, finite so contacts win."""
+_DRIVE_TORQUE = 2.0
+_ROBOT = 1
+_STATIC = 2
+
+
+@dataclass(frozen=True)
+class Contact:
+    """The robot started touching something: when, where the robot was, what it hit."""
+
+    t: float
+    x: float
+    y: float
+    what: str
+
+
+def _approach(current: float, target: float, max_delta: float) -> float:
+    return current + max(-max_delta, min(max_delta, target - current))
+
+
+def _clamp(value: float, limit: float) -> float:
+    return max(-limit, min(limit, value))
+
+
+def _box_corners(box: Box) -> list[tuple[float, float]]:
+    c, s = math.cos(box.angle), math.sin(box.angle)
+    hw, hh = box.size[0] / 2, box.size[1] / 2
+    return [(box.center[0] + c * x - s * y, box.center[1] + s * x + c * y)
+            for x, y in ((-hw, -hh), (hw, -hh), (hw, hh), (-hw, hh))]
+
+
+def _wall_corners(a: tuple[float, float], b: tuple[float, float],
+                  thickness: float) -> list[tuple[float, float]]:
+    """A thick wall as the rectangle around its centre line (for ray casting)."""
+    dx, dy = b[0] - a[0], b[1] - a[1]
+    length = math.hypot(dx, dy) or 1.0
+    nx, ny = -dy / length * thickness / 2, dx / length * thickness / 2
+    return [(a[0] + nx, a[1] + ny), (b[0] + nx, b[1] + ny),
+            (b[0] - nx, b[1] - ny), (a[0] - nx, a[1] - ny)]
+
+
+class World:
+    """The pymunk world of one :class:`WorldSpec`, stepped at a fixed ``dt``."""
+
+    def __init__(self, spec: WorldSpec, seed: int | None = None, dt: float = 0.005) -> None:
+        self.spec = spec
+        self.seed = spec.seed if seed is None else seed
+        self.dt = dt
+        self.reset()
+
+    # -- building -----------------------------------------------------------------
+    def reset(self) -> None:
+        """Rebuild the world from its spec: time 0, robot at start, run-time obstacles gone."""
+        self.space = pymunk.Space()
+        self.space.iterations = 20
+        self.steps = 0
+        self._target = (0.0, 0.0)
+        self._command = (0.0, 0.0)
+        self._contacts: list[Contact] = []
+        self._labels: dict[pymunk.Shape, str] = {}
+        self._segments: list[tuple[float, float, float, float]] = []
+        self._circles: list[tuple[float, float, float]] = []
+        self._geometry: tuple[np.ndarray, np.ndarray] | None = None
+        for i, (a, b) in enumerate(self.spec.all_walls()):
+            shape = pymunk.Segment(self.space.static_body, a, b, self.spec.wall_thickness / 2)
+            self._add_static(shape, f"wall {i}")
+            self._add_polygon(_wall_corners(a, b, self.spec.wall_thickness))
+        for i, box in enumerate(self.spec.obstacles.boxes):
+            self._add_box(box, f"box {i}")
+        for i, circle in enumerate(self.spec.obstacles.circles):
+            self._add_circle(circle, f"circle {i}")
+        self._build_robot()
+        self.space.on_collision(_ROBOT, _STATIC, begin=self._on_begin)
+
+    def _build_robot(self) -> None:
+        start = self.spec.start
+        self.control = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
+        self.control.position = (start.x, start.y)
+        self.control.angle = start.theta
+        moment = pymunk.moment_for_circle(ROBOT_MASS, 0, ROBOT_RADIUS)
+        self.robot = pymunk.Body(ROBOT_MASS, moment)
+        self.robot.position = (start.x, start.y)
+        self.robot.angle = start.theta
+        shape = pymunk.Circle(self.robot, ROBOT_RADIUS)
+        shape.friction, shape.elasticity = 0.3, 0.0
+        shape.collision_type = _ROBOT
+        pivot = pymunk.PivotJoint(self.control, self.robot, (0, 0), (0, 0))
+        pivot.max_bias, pivot.max_force = 0.0, _DRIVE_FORCE  # match velocity only
+        gear = pymunk.GearJoint(self.control, self.robot, 0.0, 1.0)
+        gear.max_bias, gear.max_force = 0.0, _DRIVE_TORQUE
+        self.space.add(self.control, self.robot, shape, pivot, gear)
+
+    def _add_static(self, shape: pymunk.Shape, label: str) -> None:
+        shape.friction, shape.elasticity = 0.3, 0.0
+        shape.collision_type = _STATIC
+        self._labels[shape] = label
+        self.space.add(shape)
+        self._geometry = None
+
+    def _add_polygon(self, corners: list[tuple[float, float]]) -> None:
+        for i, (x1, y1) in enumerate(corners):
+            x2, y2 = corners[(i + 1) % len(corners)]
+            self._segments.append((x1, y1, x2, y2))
+
+    def _add_box(self, box: Box, label: str) -> None:
+        corners = _box_corners(box)
+        self._add_static(pymunk.Poly(self.space.static_body, corners), label)
+        self._add_polygon(corners)
+
+    def _add_circle(self, circle: Circle, label: str) -> None:
+        shape = pymunk.Circle(self.space.static_body, circle.radius, circle.center)
+        self._add_static(shape, label)
+        self._circles.append((*circle.center, circle.radius))
+
+    def add_obstacle(self, obstacle: Box | Circle, label: str | None = None) -> None:
+        """Place a static obstacle now (a fault, or a test changing the world mid-run)."""
+        label = label or f"added {type(obstacle).__name__.lower()} {len(self._labels)}"
+        if isinstance(obstacle, Box):
+            self._add_box(obstacle, label)
+        else:
+            self._add_circle(obstacle, label)
+
+    def _on_begin(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: object) -> None:
+        other = next((s for s in arbiter.shapes if s.collision_type == _STATIC), None)
+        x, y = self.robot.position
+        self._contacts.append(Contact(self.time, float(x), float(y),
+                                      self._labels.get(other, "?")))
+
+    # -- driving ------------------------------------------------------------------
+    def set_command(self, linear: float, angular: float) -> None:
+        """Ask for body-frame velocities; clamped to the speed limits now, and reached
+        within the acceleration limits over the next steps."""
+        lim = self.spec.limits
+        linear = 0.0 if math.isnan(linear) else linear
+        angular = 0.0 if math.isnan(angular) else angular
+        self._target = (_clamp(linear, lim.max_linear_speed),
+                        _clamp(angular, lim.max_angular_speed))
+
+    @property
+    def command(self) -> tuple[float, float]:
+        """The velocities currently driven (after acceleration limiting)."""
+        return self._command
+
+    def step(self) -> None:
+        """Advance exactly ``dt``."""
+        lim = self.spec.limits
+        v = _approach(self._command[0], self._target[0], lim.max_linear_accel * self.dt)
+        w = _approach(self._command[1], self._target[1], lim.max_angular_accel * self.dt)
+        self._command = (v, w)
+        heading = self.robot.rotation_vector
+        self.control.velocity = (heading.x * v, heading.y * v)
+        self.control.angular_velocity = w
+        self.space.step(self.dt)
+        self.steps += 1
+
+    def drain_contacts(self) -> list[Contact]:
+        """Contacts that began since the last call."""
+        out, self._contacts = self._contacts, []
+        return out
+
+    # -- observing ----------------------------------------------------------------
+    @property
+    def time(self) -> float:
+        """Sim seconds since start (or the last reset)."""
+        return self.steps * self.dt
+
+    @property
+    def pose(self) -> tuple[float, float, float]:
+        """(x, y, theta) of the robot in the world frame, theta wrapped to (-pi, pi]."""
+        x, y = self.robot.position
+        theta = math.atan2(math.sin(self.robot.angle), math.cos(self.robot.angle))
+        return float(x), float(y), theta
+
+    @property
+    def velocity(self) -> tuple[float, float]:
+        """(linear along the heading, angular) as measured on the robot body."""
+        vel = self.robot.velocity
+        heading = self.robot.rotation_vector
+        return float(vel.x * heading.x + vel.y * heading.y), float(self.robot.angular_velocity)
+
+    @property
+    def lateral_velocity(self) -> float:
+        """Body-frame sideways velocity (non-zero only when something pushes the robot)."""
+        vel = self.robot.velocity
+        heading = self.robot.rotation_vector
+        return float(-vel.x * heading.y + vel.y * heading.x)
+
+    @property
+    def geometry(self) -> tuple[np.ndarray, np.ndarray]:
+        """Everything a ray can hit: segments (N, 4) [x1 y1 x2 y2] and circles (M, 3)."""
+        if self._geometry is None:
+            self._geometry = (np.array(self._segments, dtype=float).reshape(-1, 4),
+                              np.array(self._circles, dtype=float).reshape(-1, 3))
+        return self._geometry
