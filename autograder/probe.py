@@ -1,0 +1,187 @@
+"""The grader's probe: a node that talks to the student's node the way another node would.
+
+It publishes, records what it receives stamped with simulation time, calls services and
+sets parameters.  Every wait has a deadline in simulation time and a wall-time cap, so
+a stalled world or a hung node ends a test with a message instead of hanging it.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Callable, Iterable
+from typing import Any, Generic, TypeVar
+
+from rcl_interfaces.msg import SetParametersResult
+from rcl_interfaces.srv import GetParameters, SetParameters
+from rclpy.context import Context
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
+from rclpy.parameter import Parameter, parameter_value_to_python
+from rclpy.qos import QoSProfile, ReliabilityPolicy
+
+from autograder.errors import GraderError, StudentFailure
+from autograder.i18n import _
+
+M = TypeVar("M")
+
+PROBE_NODE_NAME = "autograder_probe"
+
+
+class Inbox(Generic[M]):
+    """Messages received on one topic, each with the simulation time it arrived at."""
+
+    def __init__(self, topic: str) -> None:
+        self.topic = topic
+        self._items: list[tuple[float, M]] = []
+        self._lock = threading.Lock()
+
+    def add(self, stamp: float, message: M) -> None:
+        with self._lock:
+            self._items.append((stamp, message))
+
+    @property
+    def items(self) -> list[tuple[float, M]]:
+        with self._lock:
+            return list(self._items)
+
+    @property
+    def messages(self) -> list[M]:
+        return [m for _, m in self.items]
+
+    @property
+    def times(self) -> list[float]:
+        return [t for t, _ in self.items]
+
+    def since(self, stamp: float) -> list[M]:
+        return [m for t, m in self.items if t >= stamp]
+
+    def __len__(self) -> int:
+        with self._lock:
+            return len(self._items)
+
+    def clear(self) -> None:
+        with self._lock:
+            self._items.clear()
+
+
+class Probe:
+    """A node in the grader's process, on the same graph as the student's node."""
+
+    def __init__(self, context: Context, world: Any, name: str = PROBE_NODE_NAME) -> None:
+        self.world = world
+        self.node = Node(name, context=context,
+                         parameter_overrides=[Parameter("use_sim_time", value=True)])
+        self._executor = SingleThreadedExecutor(context=context)
+        self._executor.add_node(self.node)
+        self._thread = threading.Thread(target=self._spin, daemon=True, name="probe-executor")
+        self._thread.start()
+        self._publishers: dict[str, Any] = {}
+
+    def _spin(self) -> None:
+        try:
+            self._executor.spin()
+        except Exception:  # noqa: BLE001 - the context shutting down ends the spin
+            pass
+
+    def close(self) -> None:
+        self._executor.shutdown(timeout_sec=2.0)
+        self.node.destroy_node()
+        self._thread.join(2.0)
+
+    @property
+    def now(self) -> float:
+        """Simulation time in seconds."""
+        return float(self.world.now)
+
+    # -- waiting -----------------------------------------------------------------------
+    def wait_for(self, condition: Callable[[], bool], sim_timeout: float,
+                 wall_timeout: float | None = None) -> bool:
+        """True once ``condition()`` holds, False when ``sim_timeout`` of sim time passed.
+
+        The wall cap (default: 4 times the sim timeout, at least 10 s) only ends waits on a
+        world that stopped advancing; it raises, as that is no verdict on the student.
+        """
+        wall = wall_timeout if wall_timeout is not None else max(10.0, 4.0 * sim_timeout)
+        start = self.now
+        if condition():
+            return True
+        done = self.world.wait_for(lambda: condition() or self.now - start >= sim_timeout,
+                                   sim_timeout=sim_timeout, wall_timeout=wall)
+        if condition():
+            return True
+        if not done and self.now - start < sim_timeout:
+            raise StudentFailure(
+                _("The simulation could not advance for {seconds:.0f} s of wall time: the "
+                  "node kept the machine too busy.").format(seconds=wall),
+                _("Look for busy loops; use timers and callbacks instead of while loops."))
+        return False
+
+    def wait_sim(self, seconds: float) -> None:
+        """Let ``seconds`` of simulation time pass (the world keeps running meanwhile)."""
+        end = self.now + seconds
+        self.wait_for(lambda: self.now >= end, seconds + 1.0)
+
+    # -- topics ------------------------------------------------------------------------
+    def subscribe(self, msg_type: type[M], topic: str, depth: int = 1000) -> Inbox[M]:
+        inbox: Inbox[M] = Inbox(topic)
+        qos = QoSProfile(depth=depth, reliability=ReliabilityPolicy.RELIABLE)
+        self.node.create_subscription(msg_type, topic, lambda m: inbox.add(self.now, m), qos)
+        return inbox
+
+    def publish(self, msg_type: type, topic: str, message: Any) -> None:
+        publisher = self._publishers.get(topic)
+        if publisher is None:
+            publisher = self.node.create_publisher(msg_type, topic, 10)
+            self._publishers[topic] = publisher
+        publisher.publish(message)
+
+    def wait_for_subscriber(self, msg_type: type, topic: str, sim_timeout: float = 5.0) -> bool:
+        """Wait until someone subscribes to ``topic`` (so our first message is not lost)."""
+        if topic not in self._publishers:
+            self._publishers[topic] = self.node.create_publisher(msg_type, topic, 10)
+        publisher = self._publishers[topic]
+        return self.wait_for(lambda: publisher.get_subscription_count() > 0, sim_timeout)
+
+    # -- graph -------------------------------------------------------------------------
+    def node_names(self) -> set[str]:
+        return {name for name, _ns in self.node.get_node_names_and_namespaces()}
+
+    # -- services and parameters ---------------------------------------------------------
+    def call(self, srv_type: type, service: str, request: Any, sim_timeout: float = 5.0) -> Any:
+        """Call a service; None when it is not available or does not answer in time."""
+        client = self.node.create_client(srv_type, service)
+        try:
+            if not self.wait_for(client.service_is_ready, sim_timeout):
+                return None
+            future = client.call_async(request)
+            if not self.wait_for(future.done, sim_timeout):
+                return None
+            return future.result()
+        finally:
+            self.node.destroy_client(client)
+
+    def set_parameters(self, node: str, values: dict[str, Any],
+                       sim_timeout: float = 5.0) -> list[SetParametersResult]:
+        request = SetParameters.Request()
+        request.parameters = [Parameter(k, value=v).to_parameter_msg() for k, v in values.items()]
+        response = self.call(SetParameters, f"/{node}/set_parameters", request, sim_timeout)
+        if response is None:
+            raise StudentFailure(
+                _("The node's set_parameters service did not answer within {seconds} s.").format(
+                    seconds=sim_timeout),
+                _("Is the node spinning? Parameter services are served by the executor."))
+        return list(response.results)
+
+    def get_parameters(self, node: str, names: Iterable[str],
+                       sim_timeout: float = 5.0) -> dict[str, Any]:
+        names = list(names)
+        request = GetParameters.Request(names=names)
+        response = self.call(GetParameters, f"/{node}/get_parameters", request, sim_timeout)
+        if response is None:
+            raise StudentFailure(
+                _("The node's get_parameters service did not answer within {seconds} s.").format(
+                    seconds=sim_timeout))
+        if len(response.values) != len(names):
+            raise GraderError(f"get_parameters returned {len(response.values)} values")
+        return {n: parameter_value_to_python(v) for n, v in zip(names, response.values,
+                                                                 strict=True)}

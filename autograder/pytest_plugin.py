@@ -1,0 +1,419 @@
+"""pytest plugin: write exercise tests as plain pytest against a live ROS 2 graph.
+
+Shaped like pytest's own ``junitxml``: options in :func:`pytest_addoption`; the
+:class:`GradingReporter` is registered in ``config.stash`` only when ``--exercise`` is
+given and removed in :func:`pytest_unconfigure`.  Fixtures give tests the simulated
+``world``, the student's running node (``student``, ``start_node``) and a ``probe``.
+Points and visibility travel through markers::
+
+    @pytest.mark.points(2)
+    @pytest.mark.visibility("hidden")
+    def test_clamps_speed(student, probe): ...
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+import time
+import traceback
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from autograder.errors import GraderError, StudentFailure
+from autograder.i18n import _, set_language
+
+reporter_key = pytest.StashKey["GradingReporter"]()
+
+
+def pytest_addoption(parser: pytest.Parser) -> None:
+    group = parser.getgroup("autograder", "rclpy autograder")
+    group.addoption("--exercise", default=None,
+                    help="exercise id or folder; turns the autograder fixtures on")
+    group.addoption("--submission", default=None,
+                    help="the student's file, or a folder holding it (default: the solution)")
+    group.addoption("--autograder-report", default=None,
+                    help="write the raw grading report (JSON) to this file")
+    group.addoption("--ros-domain", type=int, default=None,
+                    help="ROS domain id of this run (default: reserve a free one)")
+    group.addoption("--real-time-factor", type=float, default=None,
+                    help="override the exercise's real-time factor")
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    config.addinivalue_line("markers", "points(n): points the test is worth (default 1)")
+    config.addinivalue_line(
+        "markers", "visibility(v): 'visible', 'hidden' or 'after_published' (default: "
+        "hidden for tests under a hidden/ folder)")
+    config.addinivalue_line("markers", "world(name): the world this module's tests run in")
+    if config.getoption("exercise", None):
+        if os.environ.get("AUTOGRADER_LANG"):
+            set_language(os.environ["AUTOGRADER_LANG"])
+        reporter = GradingReporter(config.getoption("autograder_report"))
+        config.stash[reporter_key] = reporter
+        config.pluginmanager.register(reporter, "autograder-reporter")
+
+
+def pytest_unconfigure(config: pytest.Config) -> None:
+    reporter = config.stash.get(reporter_key, None)
+    if reporter is not None:
+        del config.stash[reporter_key]
+        config.pluginmanager.unregister(reporter)
+
+
+# -- the reporter ---------------------------------------------------------------------------
+
+def _label(item: pytest.Item) -> str:
+    doc = getattr(getattr(item, "function", None), "__doc__", None) or item.name
+    return _(doc.strip().splitlines()[0].strip())
+
+
+def _visibility(item: pytest.Item, hidden_default: str) -> str:
+    marker = item.get_closest_marker("visibility")
+    if marker and marker.args:
+        return str(marker.args[0])
+    return hidden_default if "hidden" in Path(str(item.path)).parts else "visible"
+
+
+class GradingReporter:
+    """Collects each test's outcome, points and message; writes the raw report as it goes."""
+
+    def __init__(self, path: str | None) -> None:
+        self.path = Path(path) if path else None
+        self.tests: dict[str, dict[str, Any]] = {}
+        self.data: dict[str, Any] = {"logs": {}, "recordings": {}, "processes": []}
+        self.hidden_default = "after_published"
+
+    def write(self) -> None:
+        if self.path is None:
+            return
+        tmp = self.path.with_suffix(".tmp")
+        tmp.write_text(json.dumps({"tests": list(self.tests.values()), "data": self.data},
+                                  default=str))
+        tmp.replace(self.path)
+
+    def note_process(self, pid: int, cgroups: list[str]) -> None:
+        """Record a student process so the parent can reap it if this run is killed."""
+        self.data["processes"].append({"pid": pid, "cgroups": cgroups})
+        self.write()
+
+    @pytest.hookimpl(trylast=True)
+    def pytest_collection_modifyitems(self, items: list[pytest.Item]) -> None:
+        for item in items:
+            marker = item.get_closest_marker("points")
+            self.tests[item.nodeid] = {
+                "name": item.name,
+                "label": _label(item),
+                "max_score": marker.args[0] if marker and marker.args else 1,
+                "visibility": _visibility(item, self.hidden_default),
+                "status": "error",
+                "message": _("Not run: the grading run ended before this test."),
+                "hint": "",
+                "details": "",
+            }
+        self.write()
+
+    @pytest.hookimpl(hookwrapper=True)
+    def pytest_runtest_makereport(self, item: pytest.Item,
+                                  call: pytest.CallInfo[None]) -> Iterator[None]:
+        outcome = yield
+        report = outcome.get_result()
+        entry = self.tests.get(item.nodeid)
+        if entry is None:
+            return
+        if call.when == "setup" or call.when == "call":
+            if report.passed and call.when == "call":
+                entry.update(status="passed", message="", hint="")
+            elif report.skipped:
+                entry.update(status="skipped", message=_skip_reason(report))
+            elif report.failed:
+                entry.update(_classify(call.excinfo))
+        elif call.when == "teardown" and report.failed and entry["status"] == "passed":
+            entry.update(_classify(call.excinfo))
+
+    def pytest_runtest_logfinish(self, nodeid: str) -> None:
+        self.write()
+
+
+def _skip_reason(report: pytest.TestReport) -> str:
+    longrepr = report.longrepr
+    if isinstance(longrepr, tuple) and len(longrepr) == 3:
+        return str(longrepr[2]).removeprefix("Skipped: ")
+    return str(longrepr)
+
+
+def _classify(excinfo: pytest.ExceptionInfo[BaseException] | None) -> dict[str, str]:
+    """A failing test's status: the student's failure, or our error."""
+    if excinfo is None:
+        return {"status": "failed", "message": "", "hint": "", "details": ""}
+    details = "".join(traceback.format_exception(excinfo.type, excinfo.value, excinfo.tb))
+    error = excinfo.value
+    if isinstance(error, StudentFailure):
+        return {"status": "failed", "message": error.message, "hint": error.hint,
+                "details": details}
+    if isinstance(error, AssertionError):
+        text = str(error).strip()
+        return {"status": "failed", "message": text.split("\nassert")[0].strip() or
+                _("A check failed."), "hint": "", "details": details}
+    kind = "grader error" if isinstance(error, GraderError) else type(error).__name__
+    return {"status": "error", "message": f"{kind}: {error}", "hint": "", "details": details}
+
+
+# -- fixtures -------------------------------------------------------------------------------
+
+@pytest.fixture(scope="session")
+def exercise(pytestconfig: pytest.Config) -> Any:
+    """The exercise under test (from ``--exercise``)."""
+    from autograder.exercise import find_exercise
+
+    name = pytestconfig.getoption("exercise")
+    if not name:
+        pytest.skip("run with --exercise to use the autograder fixtures")
+    found = find_exercise(name)
+    reporter = pytestconfig.stash.get(reporter_key, None)
+    if reporter is not None:
+        reporter.hidden_default = found.hidden_visibility
+    return found
+
+
+@pytest.fixture(scope="session")
+def submission_file(pytestconfig: pytest.Config, exercise: Any,
+                    tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A private copy of the student's file (the reference solution when none is given)."""
+    from autograder.submission import SubmissionNotFound, locate, stage
+
+    given = pytestconfig.getoption("submission")
+    try:
+        source = locate(Path(given), exercise.file) if given else exercise.solution
+    except SubmissionNotFound as exc:
+        raise StudentFailure(str(exc)) from None
+    return stage(source, exercise.file, tmp_path_factory.mktemp("submission"))
+
+
+@pytest.fixture(scope="session")
+def ros_context(pytestconfig: pytest.Config) -> Iterator[Any]:
+    """An rclpy context on this run's own ROS domain, discovery limited to localhost."""
+    import rclpy
+    from rclpy.context import Context
+
+    from autograder.domains import reserve_domain
+
+    os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+    given = pytestconfig.getoption("ros_domain")
+    with reserve_domain(None) if given is None else _held(given) as domain:
+        os.environ["ROS_DOMAIN_ID"] = str(domain)
+        context = Context()
+        rclpy.init(context=context, domain_id=domain)
+        try:
+            yield context
+        finally:
+            rclpy.try_shutdown(context=context)
+
+
+class _held:
+    """A domain already reserved by the parent process."""
+
+    def __init__(self, domain: int) -> None:
+        self.domain = domain
+
+    def __enter__(self) -> int:
+        return self.domain
+
+    def __exit__(self, *exc: object) -> None:
+        return None
+
+
+@pytest.fixture(scope="module")
+def world(request: pytest.FixtureRequest, exercise: Any, ros_context: Any) -> Iterator[Any]:
+    """The simulated world, running, for this test module (``@pytest.mark.world`` picks it)."""
+    from sim.bridge import SimBridge
+    from sim.physics import World
+    from sim.worldfile import load_world
+
+    marker = request.node.get_closest_marker("world")
+    name = marker.args[0] if marker and marker.args else exercise.world
+    local = exercise.folder / name
+    spec = load_world(local if local.suffix in (".yaml", ".yml") and local.exists() else name)
+    rtf = request.config.getoption("real_time_factor")
+    bridge = SimBridge(World(spec), ros_context,
+                       real_time_factor=exercise.real_time_factor if rtf is None else rtf)
+    bridge.start()
+    try:
+        yield bridge
+    finally:
+        bridge.stop()
+        reporter = request.config.stash.get(reporter_key, None)
+        if reporter is not None:
+            reporter.data["recordings"][request.node.name] = bridge.recording.to_dict()
+
+
+@pytest.fixture(scope="module")
+def probe(ros_context: Any, world: Any) -> Iterator[Any]:
+    """The grader's own node on the graph: publish, subscribe, call, set parameters."""
+    from autograder.probe import Probe
+
+    node = Probe(ros_context, world)
+    try:
+        yield node
+    finally:
+        node.close()
+
+
+class StudentNode:
+    """The student's running program, seen from the graph."""
+
+    def __init__(self, process: Any, name: str, probe: Any) -> None:
+        self.process = process
+        self.name = name
+        self.probe = probe
+
+    @property
+    def returncode(self) -> int | None:
+        return self.process.returncode
+
+    def running(self) -> bool:
+        return self.process.running()
+
+    def output(self) -> str:
+        return self.process.output_text()
+
+    def output_tail(self, lines: int = 15) -> str:
+        return self.process.output_tail(lines)
+
+    def wait_exit(self, wall_timeout: float) -> int | None:
+        return self.process.wait(wall_timeout)
+
+    def stop(self) -> int | None:
+        return self.process.stop()
+
+
+def _describe_exit(code: int) -> str:
+    if code < 0:
+        import signal
+
+        try:
+            return _("was killed by signal {name}").format(name=signal.Signals(-code).name)
+        except ValueError:
+            return _("was killed by signal {number}").format(number=-code)
+    return _("exited with status {code}").format(code=code)
+
+
+def launch(request: pytest.FixtureRequest, exercise: Any, script: Path, probe: Any,
+           world: Any, params: dict[str, Any] | None = None,
+           wait_for_node: bool = True) -> StudentNode:
+    """Start the student's program with ``use_sim_time:=true`` and wait for its node."""
+    from autograder.sandbox import StudentProcess, minimal_env
+
+    source = script.read_text(encoding="utf-8", errors="replace")
+    try:
+        compile(source, script.name, "exec")
+    except SyntaxError as exc:
+        raise StudentFailure(
+            _("{file}, line {line}: {error}").format(file=script.name, line=exc.lineno,
+                                                     error=exc.msg),
+            _("Fix the syntax error; `python -m py_compile {file}` shows it too.").format(
+                file=script.name)) from None
+    ros_args = ["-p", "use_sim_time:=true"]
+    for key, value in (params or {}).items():
+        ros_args += ["-p", f"{key}:={_ros_value(value)}"]
+    workdir = Path(tempfile.mkdtemp(prefix="student-", dir=script.parent.parent))
+    (workdir / script.name).write_bytes(script.read_bytes())
+    for sibling in script.parent.glob("*.py"):
+        if sibling.name != script.name:
+            (workdir / sibling.name).write_bytes(sibling.read_bytes())
+    env = minimal_env(workdir, {"ROS_DOMAIN_ID": os.environ["ROS_DOMAIN_ID"]})
+    process = StudentProcess(workdir / script.name, workdir, ros_args, env, exercise.limits)
+    process.start()
+    reporter = request.config.stash.get(reporter_key, None)
+    if reporter is not None:
+        reporter.note_process(process.pid, [str(p) for p in process.cgroup.paths])
+    world.watch_pid(process.pid)
+    node = StudentNode(process, exercise.node, probe)
+    if wait_for_node:
+        _wait_for_node(exercise, node, world)
+    return node
+
+
+def _ros_value(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return value if value else "''"
+    return repr(value)
+
+
+def _wait_for_node(exercise: Any, node: StudentNode, world: Any) -> None:
+    deadline = time.monotonic() + exercise.startup_timeout
+    seen: set[str] = set()
+
+    def ready() -> bool:
+        nonlocal seen
+        seen = node.probe.node_names()
+        return exercise.node in seen or not node.running() or time.monotonic() > deadline
+
+    world.wait_for(ready, sim_timeout=float("inf"), wall_timeout=exercise.startup_timeout + 1)
+    if exercise.node in seen:
+        return
+    tail = node.output_tail()
+    if not node.running():
+        code = node.returncode
+        node.stop()
+        raise StudentFailure(
+            _("Your program {how} before its node '{node}' appeared on the ROS graph.\n"
+              "Last lines of its output:\n{tail}").format(
+                how=_describe_exit(code if code is not None else 0), node=exercise.node,
+                tail=tail or _("(no output)")),
+            _("Run it yourself with `python {file} --ros-args -p use_sim_time:=true` and "
+              "read the traceback.").format(file=exercise.file))
+    others = sorted(seen - {"autograder_probe", "sim_world"})
+    node.stop()
+    raise StudentFailure(
+        _("No node named '{node}' appeared on the ROS graph within {seconds:.0f} s "
+          "(nodes seen: {others}).\nLast lines of its output:\n{tail}").format(
+            node=exercise.node, seconds=exercise.startup_timeout,
+            others=", ".join(others) or _("none"), tail=tail or _("(no output)")),
+        _("Create the node with super().__init__('{node}') and spin it.").format(
+            node=exercise.node))
+
+
+@pytest.fixture(scope="module")
+def student(request: pytest.FixtureRequest, exercise: Any, submission_file: Path,
+            probe: Any, world: Any) -> Iterator[StudentNode]:
+    """The student's node, started once for this module with its default parameters."""
+    node = launch(request, exercise, submission_file, probe, world)
+    try:
+        yield node
+    finally:
+        node.stop()
+        world.watch_pid(None)
+        _keep_log(request, node)
+
+
+@pytest.fixture
+def start_node(request: pytest.FixtureRequest, exercise: Any, submission_file: Path,
+               probe: Any, world: Any) -> Iterator[Callable[..., StudentNode]]:
+    """Start another instance of the student's program (``params`` as ``-p`` overrides)."""
+    started: list[StudentNode] = []
+
+    def start(params: dict[str, Any] | None = None, wait_for_node: bool = True) -> StudentNode:
+        node = launch(request, exercise, submission_file, probe, world, params, wait_for_node)
+        started.append(node)
+        return node
+
+    try:
+        yield start
+    finally:
+        for node in started:
+            node.stop()
+            _keep_log(request, node)
+        world.watch_pid(None)
+
+
+def _keep_log(request: pytest.FixtureRequest, node: StudentNode) -> None:
+    reporter = request.config.stash.get(reporter_key, None)
+    if reporter is not None:
+        reporter.data["logs"][request.node.nodeid] = node.output_tail(40)
