@@ -88,6 +88,7 @@ class SimBridge:
         self.poll_interval = poll_interval
         self.settle = settle
         self.max_tick = max_tick
+        self.recheck = 0.01
         self._rtf = real_time_factor
         self._adaptive_tick = 1.0 / max_clock_hz
         self._cond = threading.Condition(threading.RLock())
@@ -202,13 +203,21 @@ class SimBridge:
 
     def wait_for(self, predicate: Callable[[], bool], sim_timeout: float,
                  wall_timeout: float) -> bool:
-        """Block until ``predicate()`` holds (checked each tick); False if ``sim_timeout``
-        of sim time or ``wall_timeout`` of wall time passes first."""
+        """Block until ``predicate()`` holds; False if ``sim_timeout`` of sim time or
+        ``wall_timeout`` of wall time passes first.
+
+        The predicate is checked at every tick, and also every ``recheck`` wall seconds
+        so that one watching another thread (a probe's messages) is seen while paused.
+        """
+        end = time.monotonic() + wall_timeout
         with self._cond:
             limit = self.world.time + sim_timeout
-            self._cond.wait_for(lambda: predicate() or self.world.time >= limit,
-                                timeout=wall_timeout)
-            return bool(predicate())
+            while not predicate():
+                left = end - time.monotonic()
+                if self.world.time >= limit or left <= 0:
+                    return bool(predicate())
+                self._cond.wait(min(left, self.recheck))
+            return True
 
     # -- threads --------------------------------------------------------------------
     def _on_cmd_vel(self, msg: Twist) -> None:
