@@ -11,7 +11,10 @@ Commands received on ``/cmd_vel`` take effect at the start of the next tick.
   Jazzy's executors follow a 50-100 Hz clock well but stutter at 133 Hz and above.  At a
   real-time factor ``r > 0`` a tick is ``r / max_clock_hz`` of sim time (0.02 s at RTF 1
   and 50 Hz).  At ``r == 0`` ("as fast as the graph keeps up") the tick length adapts so
-  that one tick's work fills ``1 / max_clock_hz`` of wall time, up to ``max_tick``.
+  that one tick's work fills ``1 / max_clock_hz`` of wall time, up to ``max_tick`` (2 s):
+  the clock cap means 50x real time needs 1 s ticks, so at RTF 0 a node sees its clock
+  jump by up to ``max_tick`` at once.  Graders who care about timer granularity should
+  pick a finite RTF instead.
 * **Wall deadline.**  After publishing, the bridge waits for the tick's wall deadline.
   There is no catch-up: a late tick moves the schedule, so sim time just runs slower.
 * **Quiescence.**  With a watched process (``watch_pid``, the student's node), the bridge
@@ -78,7 +81,7 @@ class SimBridge:
     def __init__(self, world: World, context: Context, *, real_time_factor: float = 1.0,
                  max_clock_hz: float = 50.0, node_name: str = "sim_world",
                  quiescence_cap: float = 0.05, poll_interval: float = 0.0005,
-                 settle: float = 0.001, max_tick: float = 1.0) -> None:
+                 settle: float = 0.001, max_tick: float = 2.0) -> None:
         if real_time_factor < 0 or max_clock_hz <= 0:
             raise ValueError("real_time_factor must be >= 0 and max_clock_hz > 0")
         self.sim = Simulation(world)

@@ -45,7 +45,8 @@ def _clamp(value: float, limit: float) -> float:
     return max(-limit, min(limit, value))
 
 
-def _box_corners(box: Box) -> list[tuple[float, float]]:
+def box_corners(box: Box) -> list[tuple[float, float]]:
+    """The four corners of a rotated box, counter-clockwise."""
     c, s = math.cos(box.angle), math.sin(box.angle)
     hw, hh = box.size[0] / 2, box.size[1] / 2
     return [(box.center[0] + c * x - s * y, box.center[1] + s * x + c * y)
@@ -126,7 +127,7 @@ class World:
             self._segments.append((x1, y1, x2, y2))
 
     def _add_box(self, box: Box, label: str) -> None:
-        corners = _box_corners(box)
+        corners = box_corners(box)
         self._add_static(pymunk.Poly(self.space.static_body, corners), label)
         self._add_polygon(corners)
 

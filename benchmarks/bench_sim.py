@@ -1,0 +1,67 @@
+"""Real-time factor of the standard world (``obstacles``): physics + lidar alone, then
+with the ROS bridge publishing as fast as it can (RTF 0, no watched process).
+
+Run: ``python benchmarks/bench_sim.py [--sim-seconds 60] [--domain 99]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import time
+
+from sim.engine import Simulation
+from sim.physics import World
+from sim.worldfile import load_world
+
+
+def bench_headless(sim_seconds: float) -> float:
+    """Sim seconds per wall second stepping physics, lidar and faults with no ROS."""
+    sim = Simulation(World(load_world("obstacles")))
+    steps = round(sim_seconds / sim.world.dt)
+    start = time.perf_counter()
+    for i in range(steps):
+        if i % 200 == 0:  # a new command every second: wander in arcs
+            sim.world.set_command(0.4, math.sin(i / 200))
+        sim.step()
+    return sim_seconds / (time.perf_counter() - start)
+
+
+def bench_bridge(sim_seconds: float, domain: int) -> tuple[float, float]:
+    """(overall, last-window) RTF with the bridge publishing /clock, /odom and /scan."""
+    import rclpy
+    from rclpy.context import Context
+
+    from sim.bridge import SimBridge
+
+    os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+    ctx = Context()
+    rclpy.init(context=ctx, domain_id=domain)
+    bridge = SimBridge(World(load_world("obstacles")), ctx, real_time_factor=0.0)
+    bridge.world.set_command(0.4, 0.3)
+    start = time.perf_counter()
+    bridge.start()
+    try:
+        bridge.wait_until(sim_seconds, wall_timeout=600)
+        overall = bridge.now / (time.perf_counter() - start)
+        window = bridge.effective_rtf
+    finally:
+        bridge.stop()
+        rclpy.try_shutdown(context=ctx)
+    return overall, window
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--sim-seconds", type=float, default=60.0)
+    parser.add_argument("--domain", type=int, default=99)
+    args = parser.parse_args()
+    print(f"physics + lidar, no ROS: RTF {bench_headless(args.sim_seconds):.1f}x")
+    overall, window = bench_bridge(args.sim_seconds, args.domain)
+    print(f"with ROS bridge (RTF 0, 50 Hz clock cap): RTF {overall:.1f}x overall, "
+          f"{window:.1f}x at the end")
+
+
+if __name__ == "__main__":
+    main()

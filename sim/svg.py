@@ -1,0 +1,83 @@
+"""A picture of a run: the arena, walls, obstacles, the path, start, end, goal, collisions.
+
+A pure function of data returning a self-contained inline SVG (no scripts, no external
+references), so reports can embed it as is.  World y points up; SVG y points down, so
+everything is drawn inside a group that flips the y axis.
+"""
+
+from __future__ import annotations
+
+import math
+from html import escape
+
+from sim.physics import box_corners
+from sim.recorder import Recording
+from sim.worldfile import ROBOT_RADIUS, Goal, WorldSpec
+
+_PX_PER_M = 100.0
+
+
+def _num(v: float) -> str:
+    return f"{v:.3f}".rstrip("0").rstrip(".")
+
+
+def _points(points: list[tuple[float, float]]) -> str:
+    return " ".join(f"{_num(x)},{_num(y)}" for x, y in points)
+
+
+def trajectory_svg(spec: WorldSpec, recording: Recording, goal: Goal | None = None) -> str:
+    """The SVG text for ``recording`` in ``spec``'s arena (``goal`` overrides the spec's)."""
+    w, h = spec.size
+    goal = goal or spec.goal
+    samples, collisions = recording.snapshot()
+    margin = 0.1
+    parts = [
+        f'<svg xmlns="http://www.w3.org/2000/svg" class="sim-trajectory" '
+        f'width="{_num((w + 2 * margin) * _PX_PER_M)}" '
+        f'height="{_num((h + 2 * margin) * _PX_PER_M)}" '
+        f'viewBox="{_num(-margin)} {_num(-margin)} {_num(w + 2 * margin)} '
+        f'{_num(h + 2 * margin)}" role="img">',
+        f"<title>{escape(spec.title or spec.name)}</title>",
+        f'<g transform="translate(0 {_num(h)}) scale(1 -1)">',
+        f'<rect x="0" y="0" width="{_num(w)}" height="{_num(h)}" fill="#fafafa"/>',
+    ]
+    if goal is not None:
+        parts.append(f'<circle class="goal" cx="{_num(goal.x)}" cy="{_num(goal.y)}" '
+                     f'r="{_num(goal.tolerance)}" fill="#c8f7c5" stroke="#2e7d32" '
+                     f'stroke-width="0.02"/>')
+    for (x1, y1), (x2, y2) in spec.all_walls():
+        parts.append(f'<line class="wall" x1="{_num(x1)}" y1="{_num(y1)}" x2="{_num(x2)}" '
+                     f'y2="{_num(y2)}" stroke="#333" stroke-width="{_num(spec.wall_thickness)}"'
+                     f' stroke-linecap="square"/>')
+    for box in spec.obstacles.boxes:
+        parts.append(f'<polygon class="box" points="{_points(box_corners(box))}" '
+                     f'fill="#9e9e9e"/>')
+    for circle in spec.obstacles.circles:
+        parts.append(f'<circle class="obstacle" cx="{_num(circle.center[0])}" '
+                     f'cy="{_num(circle.center[1])}" r="{_num(circle.radius)}" fill="#9e9e9e"/>')
+    if samples:
+        path = [(spec.start.x, spec.start.y)] + [(s.x, s.y) for s in samples]
+        parts.append(f'<polyline class="path" points="{_points(path)}" fill="none" '
+                     f'stroke="#1565c0" stroke-width="0.02" stroke-linejoin="round"/>')
+    start = spec.start
+    parts.append(_robot("start", start.x, start.y, start.theta, "#43a047"))
+    if samples:
+        end = samples[-1]
+        parts.append(_robot("end", end.x, end.y, end.theta, "#1565c0"))
+    for c in collisions:
+        d = 0.06
+        parts.append(f'<path class="collision" d="M{_num(c.x - d)},{_num(c.y - d)} '
+                     f'L{_num(c.x + d)},{_num(c.y + d)} M{_num(c.x - d)},{_num(c.y + d)} '
+                     f'L{_num(c.x + d)},{_num(c.y - d)}" stroke="#d32f2f" stroke-width="0.03">'
+                     f"<title>{escape(f'{c.t:.2f} s: {c.what}')}</title></path>")
+    parts.append("</g></svg>")
+    return "\n".join(parts)
+
+
+def _robot(name: str, x: float, y: float, theta: float, colour: str) -> str:
+    """The robot's footprint with a line showing its heading."""
+    hx, hy = x + ROBOT_RADIUS * math.cos(theta), y + ROBOT_RADIUS * math.sin(theta)
+    return (f'<g class="{name}"><circle cx="{_num(x)}" cy="{_num(y)}" r="{_num(ROBOT_RADIUS)}"'
+            f' fill="none" stroke="{colour}" stroke-width="0.02"/>'
+            f'<line x1="{_num(x)}" y1="{_num(y)}" x2="{_num(hx)}" y2="{_num(hy)}" '
+            f'stroke="{colour}" stroke-width="0.02"/></g>')
