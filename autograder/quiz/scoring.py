@@ -1,0 +1,187 @@
+"""Score an answers file against a quiz, exactly, into the one results model."""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+from collections.abc import Mapping
+from fractions import Fraction
+from pathlib import Path
+from typing import Any
+
+from autograder.i18n import _, ngettext
+from autograder.quiz.localize import Localizer, format_number, format_percent, using_language
+from autograder.quiz.model import Question, Quiz
+from autograder.results import RunResult, TestResult, exact
+
+ANSWERS_KEYS = {"quiz", "answers", "seed", "lang", "student"}
+
+
+class AnswersError(Exception):
+    """An answers file that cannot be scored: bad JSON, wrong quiz, unknown id."""
+
+    def __init__(self, path: Path | str, message: str, line: int | None = None) -> None:
+        self.path, self.message, self.line = Path(path), message, line
+        super().__init__(str(self))
+
+    def __str__(self) -> str:
+        where = f"{self.path}:{self.line}" if self.line else str(self.path)
+        return f"{where}: {self.message}"
+
+
+def _line_of(text: str, key: str) -> int | None:
+    """Line of ``"key"`` in JSON text: good enough to point a student at the mistake."""
+    match = re.search(re.escape(json.dumps(key)), text)
+    return text.count("\n", 0, match.start()) + 1 if match else None
+
+
+def read_answers(path: Path | str, quiz: Quiz, text: str | None = None) -> dict[str, Any]:
+    """Read and check an answers file for ``quiz``; return its ``answers`` mapping."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8") if text is None else text
+    except FileNotFoundError:
+        raise AnswersError(path, _("file not found")) from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise AnswersError(path, _("cannot read file: {error}").format(error=exc)) from None
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise AnswersError(path, _("not valid JSON: {problem} (column {column})").format(
+            problem=exc.msg, column=exc.colno), exc.lineno) from None
+    return check_answers(path, quiz, data, text)
+
+
+def check_answers(path: Path | str, quiz: Quiz, data: Any, text: str = "") -> dict[str, Any]:
+    """Check the shape of decoded answers; the error names the file, line and id."""
+    if not isinstance(data, dict) or not isinstance(data.get("answers"), dict):
+        raise AnswersError(path, _('must be a JSON object {{"quiz": ..., "answers": {{...}}}}'))
+    unknown = sorted(set(data) - ANSWERS_KEYS)
+    if unknown:
+        raise AnswersError(path, _("unknown key {key!r} (expected: {known})").format(
+            key=unknown[0], known=", ".join(sorted(ANSWERS_KEYS))), _line_of(text, unknown[0]))
+    if data.get("quiz") != quiz.id:
+        raise AnswersError(path, _("answers quiz {found!r}, not {expected!r}").format(
+            found=data.get("quiz"), expected=quiz.id), _line_of(text, "quiz"))
+    answers: dict[str, Any] = data["answers"]
+    for qid, value in answers.items():
+        q = quiz.question(qid)
+        line = _line_of(text, qid)
+        if q is None:
+            raise AnswersError(path, _("no question {id!r} in quiz {quiz!r}").format(
+                id=qid, quiz=quiz.id), line)
+        _check_value(path, q, value, line)
+    return answers
+
+
+def _check_value(path: Path | str, q: Question, value: Any, line: int | None) -> None:
+    if q.type == "true_false" and isinstance(value, bool):
+        return
+    if q.type == "numeric":
+        if isinstance(value, bool) or not isinstance(value, (int, float)) \
+                or not math.isfinite(value):
+            raise AnswersError(path, _("question {id!r} needs a number, found {value!r}").format(
+                id=q.id, value=value), line)
+        return
+    chosen = value if isinstance(value, list) and q.type in ("multiple", "ordering") else [value]
+    if q.type in ("single", "true_false") and not isinstance(value, str):
+        raise AnswersError(path, _("question {id!r} needs one option id, found {value!r}").format(
+            id=q.id, value=value), line)
+    if q.type in ("multiple", "ordering") and not isinstance(value, list):
+        raise AnswersError(path, _("question {id!r} needs a list of option ids, found {value!r}")
+                           .format(id=q.id, value=value), line)
+    for option in chosen:
+        if option not in q.option_ids:
+            raise AnswersError(path, _("question {id!r} has no option {option!r} "
+                                       "(options: {ids})").format(
+                id=q.id, option=option, ids=", ".join(q.option_ids)), line)
+    if len(set(chosen)) != len(chosen):
+        raise AnswersError(path, _("question {id!r} names an option twice").format(id=q.id), line)
+
+
+def _credit(q: Question, value: Any) -> Fraction:
+    """The fraction of the question's points an answer earns (0 to 1), exactly."""
+    if value is None:
+        return Fraction(0)
+    if q.type == "single":
+        return Fraction(value == q.answer)
+    if q.type == "true_false":
+        chosen = value if isinstance(value, bool) else value == "true"
+        return Fraction(chosen == q.answer)
+    if q.type == "numeric":
+        return Fraction(abs(exact(value) - exact(q.answer)) <= exact(q.tolerance))
+    if q.type == "ordering":
+        return Fraction(list(value) == list(q.answer))
+    right, chosen = set(q.answer), set(value)
+    if not q.partial_credit:
+        return Fraction(chosen == right)
+    earned = len(chosen & right) - len(chosen - right)
+    return max(Fraction(0), Fraction(earned, len(right)))
+
+
+def needed_to_pass(quiz: Quiz) -> int:
+    """Fewest points that pass: the smallest n with n / max >= pass mark."""
+    return math.ceil(quiz.exact_pass_mark * quiz.max_score)
+
+
+def pass_summary(quiz: Quiz, lang: str) -> str:
+    """'Passing score: 70% (4/5 questions)', as the chapter says it, in ``lang``."""
+    total = quiz.max_score
+    all_single = all(q.points == 1 for q in quiz.questions)
+    with using_language(lang):
+        return _pass_summary(quiz, lang, total, all_single)
+
+
+def _pass_summary(quiz: Quiz, lang: str, total: int, all_single: bool) -> str:
+    counted = (ngettext("{needed}/{total} question", "{needed}/{total} questions", total)
+               if all_single else
+               ngettext("{needed}/{total} point", "{needed}/{total} points", total))
+    return _("Passing score: {percent} ({counted})").format(
+        percent=format_percent(quiz.exact_pass_mark, lang),
+        counted=counted.format(needed=format_number(needed_to_pass(quiz), lang),
+                               total=format_number(total, lang)))
+
+
+def score(quiz: Quiz, answers: Mapping[str, Any], lang: str = "en") -> RunResult:
+    """Score checked answers; a question left out scores 0.  Messages are in ``lang``."""
+    with using_language(lang):
+        return _score(quiz, answers, lang)
+
+
+def _score(quiz: Quiz, answers: Mapping[str, Any], lang: str) -> RunResult:
+    loc = Localizer(quiz, lang)
+    tests = []
+    for q in quiz.questions:
+        value = answers.get(q.id)
+        points = Fraction(q.points)
+        earned = _credit(q, value) * points
+        if value is None:
+            message = _("Not answered.")
+        elif earned == points:
+            message = _("Correct.")
+        elif earned:
+            message = _("Partly correct: {score} of {max} points.").format(
+                score=format_number(earned, lang), max=format_number(points, lang))
+        else:
+            message = _("Incorrect.")
+        tests.append(TestResult(
+            name=q.id, label=loc.text(q, "text").value, score=earned, max_score=points,
+            status="passed" if earned == points else "failed", message=message,
+            hint=loc.text(q, "explanation").value if q.explanation else "",
+            data={"answer": value}))
+    return RunResult(kind="quiz", id=quiz.id, title=loc.quiz_text("title").value,
+                     tests=tuple(tests), pass_mark=quiz.exact_pass_mark, lang=lang,
+                     data={"pass_summary": pass_summary(quiz, lang)})
+
+
+def result_dict(result: RunResult) -> dict[str, Any]:
+    """The results JSON: the shared shape, plus the pass summary the chapter prints."""
+    out = result.to_dict()
+    out["pass_summary"] = result.data.get("pass_summary", "")
+    return out
+
+
+def key_answers(quiz: Quiz) -> dict[str, Any]:
+    """The answers file that scores full marks (for instructors only)."""
+    return {"quiz": quiz.id, "answers": {q.id: q.key() for q in quiz.questions}}
