@@ -1,11 +1,33 @@
-"""The ``autograder`` command: a thin click layer over plain functions."""
+"""The ``autograder`` command: a thin click layer over plain functions.
+
+Exit codes: 0 when grading completed, whatever the score; 2 for usage errors (a missing
+file, an unknown exercise, a malformed content file); 3 when the autograder itself failed.
+"""
 
 from __future__ import annotations
+
+import json
+import shutil
+import sys
+from pathlib import Path
 
 import click
 
 from autograder import __version__
-from autograder.i18n import LANGUAGES, set_language
+from autograder.declarative import ContentError
+from autograder.i18n import LANGUAGES, _, set_language
+
+
+class UsageProblem(click.ClickException):
+    """Bad input from the user: one line naming the file and what is wrong."""
+
+    exit_code = 2
+
+
+class GraderFault(click.ClickException):
+    """The autograder failed: not the student's fault."""
+
+    exit_code = 3
 
 
 @click.group()
@@ -16,3 +38,169 @@ def main(lang: str | None) -> None:
     """Grade rclpy exercises in a simulated ROS 2 world, and take quizzes."""
     if lang:
         set_language(lang)
+
+
+def _exercise(name: str):  # noqa: ANN202 - returns autograder.exercise.Exercise
+    from autograder.exercise import find_exercise
+
+    try:
+        return find_exercise(name)
+    except ContentError as exc:
+        raise UsageProblem(str(exc)) from None
+
+
+def _lang_option(func):  # noqa: ANN001, ANN202
+    """``--lang`` on a subcommand too (``autograder grade ... --lang ur``)."""
+
+    def set_lang(ctx: click.Context, param: click.Parameter, value: str | None) -> None:
+        if value:
+            set_language(value)
+
+    return click.option("--lang", type=click.Choice(LANGUAGES), default=None,
+                        expose_value=False, is_eager=True, callback=set_lang,
+                        help="Language of the feedback (en, ur).")(func)
+
+
+@main.command("list")
+@click.option("--json", "as_json", is_flag=True, help="Print JSON for tools.")
+def list_command(as_json: bool) -> None:
+    """List the exercises and quizzes."""
+    from autograder.exercise import list_exercises
+
+    try:
+        exercises = list_exercises()
+    except ContentError as exc:
+        raise UsageProblem(str(exc)) from None
+    quizzes = _quizzes()
+    if as_json:
+        click.echo(json.dumps({
+            "exercises": [{"id": e.id, "title": e.title, "file": e.file, "node": e.node,
+                           "languages": list(LANGUAGES)} for e in exercises],
+            "quizzes": [{"id": q.id, "title": q.title, "languages": list(q.languages)}
+                        for q in quizzes],
+        }, ensure_ascii=False, indent=2))
+        return
+    click.echo(_("Exercises:"))
+    for e in exercises:
+        click.echo(f"  {e.id:<24} {_(e.title)}")
+    if quizzes:
+        click.echo(_("Quizzes:"))
+        for q in quizzes:
+            click.echo(f"  {q.id:<24} {q.title}")
+
+
+def _quizzes() -> list:
+    try:
+        from autograder.quiz.catalog import list_quizzes
+    except ImportError:
+        return []
+    try:
+        return list_quizzes()
+    except ContentError as exc:
+        raise UsageProblem(str(exc)) from None
+
+
+@main.command()
+@click.argument("exercise")
+@click.argument("directory", required=False, type=click.Path(path_type=Path))
+def start(exercise: str, directory: Path | None) -> None:
+    """Copy an exercise's starter code and README into DIRECTORY (default: the exercise id)."""
+    found = _exercise(exercise)
+    target = directory or Path(found.id)
+    target.mkdir(parents=True, exist_ok=True)
+    copied = []
+    for source in (found.starter, *sorted(found.folder.glob("README*.md"))):
+        dest = target / source.name
+        if dest.exists():
+            raise UsageProblem(_("{path} already exists; not overwriting your work").format(
+                path=dest))
+        shutil.copy2(source, dest)
+        copied.append(dest)
+    for path in copied:
+        click.echo(_("created {path}").format(path=path))
+    click.echo(_("Next: edit {file}, then run `autograder check {exercise} {file}`").format(
+        file=target / found.file, exercise=found.id))
+
+
+def _run(exercise: str, submission: Path, hidden: bool, results: Path | None,
+         rtf: float | None, domain: int | None) -> None:
+    from autograder.grading import grade
+    from autograder.render.jsonfile import to_json
+    from autograder.render.terminal import test_line, to_terminal
+    from autograder.results import TestResult, exact
+    from autograder.submission import SubmissionNotFound, locate
+
+    found = _exercise(exercise)
+    try:
+        locate(submission, found.file)
+    except SubmissionNotFound as exc:
+        raise UsageProblem(str(exc)) from None
+    color = sys.stdout.isatty()
+
+    def progress(raw: dict) -> None:
+        score = exact(raw["max_score"]) if raw["status"] == "passed" else exact(0)
+        click.echo(test_line(TestResult(
+            name=raw["name"], label=raw["label"], score=score,
+            max_score=exact(raw["max_score"]), status=raw["status"], message=raw["message"],
+            visibility=raw["visibility"]), color, reveal=False), err=True)
+
+    click.echo(_("Grading {file} for {exercise} in the simulator...").format(
+        file=submission, exercise=found.id), err=True)
+    result = grade(found, submission, hidden=hidden, domain=domain, real_time_factor=rtf,
+                   progress=progress)
+    click.echo(to_terminal(result, color=color))
+    if results is not None:
+        results.write_text(to_json(result), encoding="utf-8")
+    if result.grader_error:
+        raise GraderFault(result.grader_error)
+
+
+_submission = click.argument("submission", type=click.Path(path_type=Path))
+_results = click.option("--results", type=click.Path(path_type=Path, dir_okay=False),
+                        help="Write the results as JSON to this file.")
+_rtf = click.option("--real-time-factor", "rtf", type=float, default=None,
+                    help="Override the exercise's simulation pace.")
+_domain = click.option("--domain", type=click.IntRange(0, 232), default=None,
+                       help="ROS domain id (default: a free one, reserved for the run).")
+
+
+@main.command()
+@click.argument("exercise")
+@_submission
+@_results
+@_rtf
+@_domain
+@_lang_option
+def check(exercise: str, submission: Path, results: Path | None, rtf: float | None,
+          domain: int | None) -> None:
+    """Run the public tests of EXERCISE on SUBMISSION (for students)."""
+    _run(exercise, submission, False, results, rtf, domain)
+
+
+@main.command("grade")
+@click.argument("exercise")
+@_submission
+@_results
+@_rtf
+@_domain
+@_lang_option
+def grade_command(exercise: str, submission: Path, results: Path | None, rtf: float | None,
+                  domain: int | None) -> None:
+    """Run the public and hidden tests of EXERCISE on SUBMISSION (the student's .py file or a
+    folder holding it)."""
+    _run(exercise, submission, True, results, rtf, domain)
+
+
+def _mount_optional() -> None:
+    """Mount the command groups that live in their own modules."""
+    for module, attr, name in (("sim.cli", "sim_cli", "sim"),
+                               ("autograder.quiz.cli", "quiz_cli", "quiz"),
+                               ("autograder.i18n_cli", "i18n_cli", "i18n")):
+        try:
+            group = getattr(__import__(module, fromlist=[attr]), attr)
+        except (ImportError, AttributeError):
+            continue
+        main.add_command(group, name)
+
+
+_mount_optional()

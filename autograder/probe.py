@@ -34,6 +34,11 @@ class Inbox(Generic[M]):
         self.topic = topic
         self._items: list[tuple[float, M]] = []
         self._lock = threading.Lock()
+        self.subscription: Any = None
+
+    def publisher_count(self) -> int:
+        """Publishers matched with this inbox's subscription (0 until discovery)."""
+        return self.subscription.get_publisher_count() if self.subscription else 0
 
     def add(self, stamp: float, message: M) -> None:
         with self._lock:
@@ -125,7 +130,8 @@ class Probe:
     def subscribe(self, msg_type: type[M], topic: str, depth: int = 1000) -> Inbox[M]:
         inbox: Inbox[M] = Inbox(topic)
         qos = QoSProfile(depth=depth, reliability=ReliabilityPolicy.RELIABLE)
-        self.node.create_subscription(msg_type, topic, lambda m: inbox.add(self.now, m), qos)
+        inbox.subscription = self.node.create_subscription(
+            msg_type, topic, lambda m: inbox.add(self.now, m), qos)
         return inbox
 
     def publish(self, msg_type: type, topic: str, message: Any) -> None:

@@ -106,6 +106,8 @@ class GradingReporter:
         for item in items:
             marker = item.get_closest_marker("points")
             self.tests[item.nodeid] = {
+                "nodeid": item.nodeid,
+                "done": False,
                 "name": item.name,
                 "label": _label(item),
                 "max_score": marker.args[0] if marker and marker.args else 1,
@@ -136,6 +138,8 @@ class GradingReporter:
             entry.update(_classify(call.excinfo))
 
     def pytest_runtest_logfinish(self, nodeid: str) -> None:
+        if nodeid in self.tests:
+            self.tests[nodeid]["done"] = True
         self.write()
 
 

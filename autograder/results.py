@@ -7,6 +7,7 @@ Renderers are pure functions of a :class:`RunResult`; see ``autograder.render``.
 from __future__ import annotations
 
 import dataclasses
+from decimal import Decimal
 from fractions import Fraction
 from typing import Any, Literal
 
@@ -22,6 +23,12 @@ def exact(value: float | int | str | Fraction) -> Fraction:
     if isinstance(value, float):
         return Fraction(repr(value))
     return Fraction(value)
+
+
+def as_decimal(value: Fraction, places: int = 6) -> Decimal:
+    """A Fraction as a Decimal (for Babel's number formatting), rounded to ``places``."""
+    return (Decimal(value.numerator) / Decimal(value.denominator)).quantize(
+        Decimal(1).scaleb(-places))
 
 
 def number(value: Fraction) -> int | float:

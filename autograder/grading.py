@@ -1,0 +1,161 @@
+"""Grade a submission: run the exercise's tests in a child pytest, turn its report into a
+:class:`~autograder.results.RunResult`.
+
+The tests (and the world and probe they use) run in a child process, so a crash there is
+reported as a grader fault instead of taking the CLI down, and a run past its time limit
+is stopped with everything it started.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Callable
+from fractions import Fraction
+from pathlib import Path
+from typing import Any
+
+from autograder.domains import reserve_domain
+from autograder.exercise import Exercise
+from autograder.i18n import _, get_language
+from autograder.results import RunResult, TestResult, exact
+from autograder.sandbox import Cgroup
+
+GRADER_FAULT = "the autograder failed, tell your instructor"
+
+
+def grade(exercise: Exercise, submission: Path | None, *, hidden: bool = True,
+          domain: int | None = None, real_time_factor: float | None = None,
+          progress: Callable[[dict[str, Any]], None] | None = None) -> RunResult:
+    """Run the exercise's public (and, with ``hidden``, hidden) tests on ``submission``.
+
+    ``submission`` is the student's file or a folder holding it; None grades the reference
+    solution.  Always returns a result: a broken submission scores what it showed, a fault
+    of ours sets ``grader_error``.
+    """
+    started = time.monotonic()
+    folders = [exercise.public_tests] + ([exercise.hidden_tests] if hidden else [])
+    folders = [f for f in folders if f.is_dir()]
+    with tempfile.TemporaryDirectory(prefix="autograder-") as tmp, \
+            reserve_domain(domain) as ros_domain:
+        report_path = Path(tmp) / "report.json"
+        command = [
+            sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
+            "--rootdir", str(exercise.folder), "--basetemp", str(Path(tmp) / "pytest"),
+            "--exercise", str(exercise.folder), "--autograder-report", str(report_path),
+            "--ros-domain", str(ros_domain), *(str(f) for f in folders),
+        ]
+        if submission is not None:
+            command += ["--submission", str(Path(submission).resolve())]
+        if real_time_factor is not None:
+            command += ["--real-time-factor", str(real_time_factor)]
+        env = dict(os.environ, AUTOGRADER_LANG=get_language(), ROS_DOMAIN_ID=str(ros_domain),
+                   AUTOGRADER_COURSE=str(exercise.folder.parent.parent),
+                   PYTHONDONTWRITEBYTECODE="1")
+        log_path = Path(tmp) / "pytest.log"
+        with log_path.open("wb") as log:
+            child = subprocess.Popen(command, cwd=tmp, env=env, stdout=log,
+                                     stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
+                                     start_new_session=True)
+            timed_out = _wait(child, exercise.time_limit, report_path, progress)
+        report = _read_report(report_path)
+        _reap(child, report)
+        pytest_log = log_path.read_text(errors="replace")
+    return _result(exercise, report, child.returncode, timed_out, pytest_log,
+                   time.monotonic() - started)
+
+
+def _wait(child: subprocess.Popen[bytes], limit: float, report_path: Path,
+          progress: Callable[[dict[str, Any]], None] | None) -> bool:
+    """Wait for the pytest child, calling ``progress`` as tests finish; True if it ran over."""
+    deadline = time.monotonic() + limit
+    reported: set[str] = set()
+    while True:
+        try:
+            child.wait(timeout=0.25)
+            finished = True
+        except subprocess.TimeoutExpired:
+            finished = False
+        if progress is not None:
+            for test in _read_report(report_path).get("tests", []):
+                if test.get("done") and test["nodeid"] not in reported:
+                    reported.add(test["nodeid"])
+                    progress(test)
+        if finished:
+            return False
+        if time.monotonic() > deadline:
+            os.killpg(child.pid, signal.SIGKILL)
+            child.wait()
+            return True
+
+
+def _read_report(path: Path) -> dict[str, Any]:
+    try:
+        return json.loads(path.read_text())
+    except (OSError, ValueError):
+        return {}
+
+
+def _reap(child: subprocess.Popen[bytes], report: dict[str, Any]) -> None:
+    """Make sure nothing the run started outlives it (the child's group, students' cgroups)."""
+    try:
+        os.killpg(child.pid, signal.SIGKILL)
+    except (ProcessLookupError, PermissionError):
+        pass
+    for process in report.get("data", {}).get("processes", []):
+        try:
+            os.killpg(process["pid"], signal.SIGKILL)
+        except (ProcessLookupError, PermissionError):
+            pass
+        for path in process.get("cgroups", []):
+            group = Cgroup.__new__(Cgroup)
+            group.paths = [Path(path)]
+            group.kill_all()
+            group.remove()
+
+
+def _result(exercise: Exercise, report: dict[str, Any], returncode: int | None,
+            timed_out: bool, pytest_log: str, elapsed: float) -> RunResult:
+    tests = []
+    errors = []
+    for raw in report.get("tests", []):
+        status = raw["status"]
+        max_score = exact(raw["max_score"])
+        message = raw["message"]
+        if timed_out and status == "error" and not raw.get("done"):
+            status, message = "failed", _(
+                "Not run: grading stopped at its time limit of {seconds:.0f} s.").format(
+                seconds=exercise.time_limit)
+        if status == "error":
+            errors.append(f"{raw['name']}: {message}\n{raw.get('details', '')}")
+        tests.append(TestResult(
+            name=raw["name"], label=raw["label"],
+            score=max_score if status == "passed" else Fraction(0), max_score=max_score,
+            status=status, message=message, hint=raw.get("hint", ""),
+            visibility=raw["visibility"], details=raw.get("details", "")))
+    grader_error = None
+    details = ""
+    if errors:
+        grader_error, details = GRADER_FAULT, "\n\n".join(errors)
+    elif not tests:
+        grader_error, details = GRADER_FAULT, pytest_log[-4000:]
+    elif returncode not in (0, 1) and not timed_out:
+        grader_error, details = GRADER_FAULT, pytest_log[-4000:]
+    total = sum((t.max_score for t in tests), Fraction(0))
+    if exercise.points and tests and total != exercise.points and grader_error is None:
+        grader_error = GRADER_FAULT
+        details = (f"{exercise.folder / 'exercise.yaml'}: points is {exercise.points} but the "
+                   f"tests add up to {total}")
+    data = report.get("data", {})
+    logs = data.get("logs", {})
+    return RunResult(
+        kind="exercise", id=exercise.id, title=_(exercise.title), tests=tuple(tests),
+        pass_mark=exercise.pass_fraction, lang=get_language(), grader_error=grader_error,
+        grader_details=details, log_tail="\n".join(logs.values())[-4000:],
+        execution_time=elapsed,
+        data={"recordings": data.get("recordings", {}), "timed_out": timed_out})

@@ -1,0 +1,1 @@
+"""Pure renderers of a :class:`~autograder.results.RunResult`: one module per format."""

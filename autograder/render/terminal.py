@@ -1,0 +1,58 @@
+"""The terminal summary: a line per test with a mark, points and a one-line reason."""
+
+from __future__ import annotations
+
+from babel.numbers import format_percent
+
+from autograder.i18n import _
+from autograder.results import RunResult, TestResult, as_decimal, number
+
+_MARKS = {"passed": ("✔", "green"), "failed": ("✘", "red"), "error": ("!", "yellow"),
+          "skipped": ("-", "yellow")}
+
+
+def _style(text: str, color: str | None, enabled: bool, bold: bool = False) -> str:
+    if not enabled:
+        return text
+    import click
+
+    return click.style(text, fg=color, bold=bold)
+
+
+def test_line(test: TestResult, color: bool = False, reveal: bool = True) -> str:
+    mark, tint = _MARKS[test.status]
+    points = f"{number(test.score)}/{number(test.max_score)}"
+    line = f" {_style(mark, tint, color)} {points:>5}  {test.label}"
+    if test.status != "passed" and reveal and test.message:
+        first = test.message.strip().splitlines()[0]
+        line += "\n" + " " * 10 + _style(first, None, color)
+    return line
+
+
+def to_terminal(result: RunResult, color: bool = False, show_details: bool = True) -> str:
+    """The whole summary. ``show_details`` adds every failure's full message and hint."""
+    lines = [_style(f"{result.id} — {result.title}", None, color, bold=True), ""]
+    for test in result.tests:
+        reveal = test.visibility == "visible" or show_details
+        lines.append(test_line(test, color, reveal))
+    lines.append("")
+    percent = format_percent(as_decimal(result.fraction), locale=result.lang)
+    mark = format_percent(as_decimal(result.pass_mark), locale=result.lang)
+    verdict = _("passed") if result.passed else _("not passed")
+    lines.append(_style(_("Score: {score}/{max_score} ({percent}), {verdict} (pass mark {mark})")
+                        .format(score=number(result.score), max_score=number(result.max_score),
+                                percent=percent, verdict=verdict, mark=mark),
+                        "green" if result.passed else "red", color, bold=True))
+    if result.grader_error:
+        lines.append(_style(_("The autograder failed, tell your instructor."), "yellow", color,
+                            bold=True))
+        if show_details and result.grader_details:
+            lines.append(result.grader_details.strip()[-2000:])
+    if show_details:
+        failures = [t for t in result.tests if t.status == "failed" and
+                    (t.visibility == "visible" or show_details)]
+        for test in failures:
+            lines += ["", _style(f"✘ {test.label}", "red", color, bold=True), test.message]
+            if test.hint:
+                lines.append(_("Hint: {hint}").format(hint=test.hint))
+    return "\n".join(lines)
