@@ -3,6 +3,10 @@
 Each world is a small YAML file parsed into the frozen :class:`WorldSpec`, so instructors
 write data, not code.  The outer walls of the arena are always present; ``walls`` lists the
 inner ones.  A malformed file raises :class:`ContentError` naming the file, line and field.
+
+Every field of :class:`WorldSpec` has a default, so the smallest world file is empty of
+choices; inside list items, what cannot be guessed (a circle's centre and radius, a box's
+centre and size, a goal's position, a fault's kind) is required.
 """
 
 from __future__ import annotations
@@ -47,8 +51,8 @@ class Pose:
 class Goal:
     """A target region the exercise may ask the robot to reach."""
 
-    x: float = _f(0.0, "x of the goal centre (m)")
-    y: float = _f(0.0, "y of the goal centre (m)")
+    x: float = field(metadata={"doc": "x of the goal centre (m)"})
+    y: float = field(metadata={"doc": "y of the goal centre (m)"})
     tolerance: float = _f(0.2, "radius around the centre that counts as reached (m)")
 
 
@@ -56,8 +60,8 @@ class Goal:
 class Box:
     """A static rectangular obstacle."""
 
-    center: Point = _f((0.0, 0.0), "centre [x, y] (m)")
-    size: Point = _f((0.3, 0.3), "[width, height] before rotation (m)")
+    center: Point = field(metadata={"doc": "centre [x, y] (m)"})
+    size: Point = field(metadata={"doc": "[width, height] before rotation (m)"})
     angle: float = _f(0.0, "rotation (rad)")
 
 
@@ -65,8 +69,8 @@ class Box:
 class Circle:
     """A static round obstacle (a pillar, a bin)."""
 
-    center: Point = _f((0.0, 0.0), "centre [x, y] (m)")
-    radius: float = _f(0.1, "radius (m)")
+    center: Point = field(metadata={"doc": "centre [x, y] (m)"})
+    radius: float = field(metadata={"doc": "radius (m)"})
 
 
 @dataclass(frozen=True)
@@ -91,8 +95,8 @@ class RobotLimits:
 class Fault:
     """A fault to inject: a corrupted or missing scan for a time span, or a new obstacle."""
 
-    kind: FaultKind = _f("nan", "nan, inf, neg_inf, below_min, above_max, empty, "
-                              "wrong_length, dropout or obstacle")
+    kind: FaultKind = field(metadata={"doc": "nan, inf, neg_inf, below_min, above_max, "
+                                             "empty, wrong_length, dropout or obstacle"})
     start: float = _f(0.0, "sim time the fault begins (s)")
     end: float | None = _f(None, "sim time the fault ends (s); none means never")
     fraction: float = _f(0.1, "share of beams affected, for the per-beam kinds (0..1)")
@@ -111,11 +115,15 @@ class WorldSpec:
     walls: tuple[Segment, ...] = _f((), "inner walls as [[x1, y1], [x2, y2]] segments")
     wall_thickness: float = _f(0.05, "thickness of every wall, outer ones included (m)")
     obstacles: Obstacles = _f(Obstacles, "static boxes and circles")
-    start: Pose = _f(Pose, "the robot's start pose")
+    start: Pose = _f(None, "the robot's start pose (default: the arena's centre, facing +x)")
     goal: Goal | None = _f(None, "optional goal region")
     limits: RobotLimits = _f(RobotLimits, "the robot's speed and acceleration limits")
     faults: tuple[Fault, ...] = _f((), "faults injected during the run")
     seed: int = _f(0, "seed for everything random (faults that pick beams)")
+
+    def __post_init__(self) -> None:
+        if self.start is None:  # the centre of whatever size was given
+            object.__setattr__(self, "start", Pose(self.size[0] / 2, self.size[1] / 2, 0.0))
 
     def all_walls(self) -> tuple[Segment, ...]:
         """Outer walls around the arena followed by the inner walls."""

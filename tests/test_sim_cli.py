@@ -1,0 +1,39 @@
+"""The ``sim`` command group: worlds, check, and a short standalone run."""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+from click.testing import CliRunner
+
+from sim.cli import sim_cli
+
+
+def test_worlds_lists_shipped_worlds() -> None:
+    result = CliRunner().invoke(sim_cli, ["worlds"])
+    assert result.exit_code == 0
+    assert "corridor" in result.output and "wall_ahead" in result.output
+
+
+def test_check_good_and_bad(tmp_path: Path) -> None:
+    good = CliRunner().invoke(sim_cli, ["check", "sim/worlds/obstacles.yaml"])
+    assert good.exit_code == 0 and "ok" in good.output
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("size: [6, 6]\nradius: 3\n")
+    result = CliRunner().invoke(sim_cli, ["check", str(bad)])
+    assert result.exit_code == 2
+    assert f"{bad}:2: radius: unknown field" in result.output
+
+
+def test_run_writes_record_and_svg(tmp_path: Path) -> None:
+    os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+    record, svg = tmp_path / "run.json", tmp_path / "run.svg"
+    result = CliRunner().invoke(sim_cli, [
+        "run", "--world", "corridor", "--rtf", "0", "--duration", "3", "--domain", "101",
+        "--record", str(record), "--svg", str(svg), "--seed", "3"])
+    assert result.exit_code == 0, result.output
+    assert "Goal reached: no" in result.output
+    assert len(json.loads(record.read_text())["trajectory"]) >= 150
+    assert svg.read_text().startswith("<svg")
