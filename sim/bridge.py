@@ -173,7 +173,9 @@ class SimBridge:
 
     def watch_pid(self, pid: int | None) -> None:
         """Hold sim time back while process ``pid`` has work to do (None: watch nothing)."""
-        self._pid = pid
+        with self._cond:
+            self._pid = pid
+            self._window.clear()
 
     # -- observing ------------------------------------------------------------------
     @property

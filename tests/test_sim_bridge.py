@@ -6,6 +6,8 @@ from __future__ import annotations
 import fcntl
 import math
 import os
+import subprocess
+import sys
 import threading
 from collections.abc import Iterator
 from dataclasses import dataclass, field
@@ -23,7 +25,7 @@ from sensor_msgs.msg import LaserScan
 
 from sim.bridge import SimBridge, process_busy
 from sim.physics import World
-from sim.worldfile import load_world
+from sim.worldfile import Box, load_world
 
 WALL = 20.0  # generous wall-clock deadline for any one condition
 
@@ -152,6 +154,87 @@ def test_pause_step_reset(graph: tuple[SimBridge, Probe]) -> None:
     bridge.resume()
     assert bridge.wait_until(0.5, wall_timeout=WALL)
     assert bridge.effective_rtf > 0.5
+
+
+def _rtf_over(bridge: SimBridge, sim_seconds: float) -> float:
+    """Measured RTF over the next ``sim_seconds`` of sim time."""
+    assert bridge.wait_until(bridge.now + 0.1, wall_timeout=WALL)  # fresh window
+    assert bridge.wait_until(bridge.now + sim_seconds, wall_timeout=WALL)
+    return bridge.effective_rtf
+
+
+def test_watched_process_paces_sim_time(graph: tuple[SimBridge, Probe]) -> None:
+    """A busy student process holds sim time back; an idle one does not."""
+    bridge, _ = graph
+    bridge.set_real_time_factor(1.0)
+    busy = subprocess.Popen([sys.executable, "-c", "while True: pass"])
+    idle = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    try:
+        bridge.watch_pid(busy.pid)
+        slowed = _rtf_over(bridge, 0.4)
+        bridge.watch_pid(idle.pid)
+        free = _rtf_over(bridge, 0.4)
+    finally:
+        bridge.watch_pid(None)
+        for proc in (busy, idle):
+            proc.kill()
+            proc.wait()
+    # A tick is 0.02 s of sim time and may wait up to 0.05 s of wall time for quiescence.
+    assert slowed < 0.6, slowed
+    assert free > 0.85, free
+
+
+STUDENT = """
+import rclpy
+from geometry_msgs.msg import Twist
+from rclpy.node import Node
+from sensor_msgs.msg import LaserScan
+
+class StopBeforeWall(Node):
+    def __init__(self):
+        super().__init__("student", parameter_overrides=[
+            rclpy.parameter.Parameter("use_sim_time", value=True)])
+        self.pub = self.create_publisher(Twist, "/cmd_vel", 10)
+        self.create_subscription(LaserScan, "/scan", self.on_scan, 10)
+
+    def on_scan(self, msg):
+        cmd = Twist()
+        cmd.linear.x = 0.3 if msg.ranges[0] > 0.5 else 0.0
+        self.pub.publish(cmd)
+
+rclpy.init()
+rclpy.spin(StopBeforeWall())
+"""
+
+
+def test_student_process_stops_before_wall(tmp_path, graph: tuple[SimBridge, Probe]) -> None:
+    """A separate use_sim_time process drives on /scan; paced by quiescence it stops in
+    time, in the wall_ahead geometry rebuilt by a run-time obstacle."""
+    bridge, probe = graph
+    bridge.pause()
+    bridge.reset()
+    bridge.world.add_obstacle(Box(center=(4.025, 3.0), size=(0.05, 4.0)))  # face at x = 4
+    script = tmp_path / "student.py"
+    script.write_text(STUDENT)
+    env = {**os.environ, "ROS_DOMAIN_ID": str(bridge.node.context.get_domain_id())}
+    student = subprocess.Popen([sys.executable, str(script)], env=env)
+    try:
+        bridge.watch_pid(student.pid)
+        assert bridge.wait_for(lambda: bridge.node.count_publishers("/cmd_vel") >= 2,
+                               sim_timeout=math.inf, wall_timeout=WALL)
+        bridge.resume()
+        assert bridge.wait_for(lambda: bridge.world.velocity[0] > 0.29, sim_timeout=3.0,
+                               wall_timeout=WALL)
+        assert bridge.wait_for(lambda: abs(bridge.world.velocity[0]) < 1e-3, sim_timeout=5.0,
+                               wall_timeout=WALL)
+        assert bridge.wait_until(bridge.now + 0.5, wall_timeout=WALL)
+        x = bridge.world.pose[0]
+        assert 3.5 <= x < 3.56, x  # sees 0.5 m by x = 3.5, then <= 1 scan + 1 tick + braking
+        assert bridge.recording.collisions == []
+    finally:
+        bridge.watch_pid(None)
+        student.terminate()
+        student.wait(timeout=WALL)
 
 
 def test_process_busy_reads_proc() -> None:
