@@ -1,8 +1,8 @@
 """Errors the quiz and i18n commands print: one line naming the file, never a traceback.
 
-Exit codes: 1 a lint found problems (or a scored quiz did not pass), 3 a quiz, exercise or
-catalog file is malformed or missing, 4 an answers file cannot be scored, 5 the server
-could not start.
+Exit codes follow ``autograder.cli``: 0 when scoring completed, whatever the score; 1 when
+lint found problems; 2 for bad input (a malformed or missing quiz, exercise, catalog or
+answers file, an unknown quiz, a port in use).
 """
 
 from __future__ import annotations
@@ -13,13 +13,13 @@ import click
 class ContentFileError(click.ClickException):
     """A quiz, exercise or catalog file is malformed, or a quiz id is unknown."""
 
-    exit_code = 3
+    exit_code = 2
 
 
 class AnswersFileError(click.ClickException):
     """An answers file is not valid JSON, answers another quiz or names unknown ids."""
 
-    exit_code = 4
+    exit_code = 2
 
 
 class LintFailed(click.ClickException):
@@ -31,4 +31,4 @@ class LintFailed(click.ClickException):
 class ServeError(click.ClickException):
     """The quiz server could not bind its address."""
 
-    exit_code = 5
+    exit_code = 2

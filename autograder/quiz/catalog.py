@@ -1,0 +1,56 @@
+"""The course's quizzes: every ``quizzes/*.yaml`` file, found by id."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+from autograder.course import course_root
+from autograder.declarative import ContentError
+from autograder.i18n import _
+from autograder.quiz.model import QuizFile, load_quiz
+
+
+@dataclasses.dataclass(frozen=True)
+class QuizEntry:
+    """What ``autograder list`` shows of a quiz."""
+
+    id: str
+    title: str
+    languages: tuple[str, ...]
+    path: Path
+    kind: str = "quiz"
+
+
+def quizzes_dir(root: Path | None = None) -> Path:
+    return (root or course_root()) / "quizzes"
+
+
+def quiz_paths(root: Path | None = None) -> list[Path]:
+    folder = quizzes_dir(root)
+    return sorted([*folder.glob("*.yaml"), *folder.glob("*.yml")])
+
+
+def load_all(root: Path | None = None) -> list[QuizFile]:
+    """Every quiz; the first malformed file raises its ContentError."""
+    return [load_quiz(p) for p in quiz_paths(root)]
+
+
+def find_quiz(name: str, root: Path | None = None) -> QuizFile:
+    """A quiz by id, or by the path of its file."""
+    path = Path(name)
+    if path.suffix in (".yaml", ".yml") and path.exists():
+        return load_quiz(path)
+    for p in quiz_paths(root):
+        qf = load_quiz(p)
+        if qf.quiz.id == name:
+            return qf
+    known = ", ".join(load_quiz(p).quiz.id for p in quiz_paths(root)) or "-"
+    raise ContentError(quizzes_dir(root), _("no quiz {id!r} (quizzes: {known})").format(
+        id=name, known=known))
+
+
+def list_quizzes(root: Path | None = None) -> list[QuizEntry]:
+    """Quizzes for ``autograder list --json``: id, title and languages."""
+    return [QuizEntry(qf.quiz.id, qf.quiz.title, qf.quiz.languages, qf.path)
+            for qf in load_all(root)]

@@ -1,0 +1,291 @@
+"""``autograder quiz``: list, lint, render, take, score, key and serve quizzes.
+
+A thin click layer: each command calls plain functions of the quiz package, and every
+bad input becomes one line naming the file (see ``autograder.quiz.errors``).
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any, TypeVar
+
+import click
+
+from autograder.declarative import ContentError
+from autograder.i18n import (
+    LANGUAGES,
+    _,
+    get_language,
+    is_rtl,
+    locales_dir,
+    ngettext,
+    set_language,
+)
+from autograder.i18n_tools import CatalogError, read_catalog
+from autograder.quiz import CONTENT_DOMAIN
+from autograder.quiz.catalog import find_quiz, list_quizzes, load_all
+from autograder.quiz.errors import AnswersFileError, ContentFileError, LintFailed, ServeError
+from autograder.quiz.localize import Localizer, format_number, format_percent, terminal
+from autograder.quiz.model import Quiz
+from autograder.quiz.render import question_views, render_markdown, render_page
+from autograder.quiz.scoring import (
+    AnswersError,
+    key_answers,
+    pass_summary,
+    read_answers,
+    result_dict,
+    score,
+)
+from autograder.results import RunResult
+
+F = TypeVar("F", bound=Callable[..., Any])
+
+
+def _errors(func: F) -> F:
+    """Turn our error types into one-line ClickExceptions."""
+
+    @functools.wraps(func)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        try:
+            return func(*args, **kwargs)
+        except (ContentError, CatalogError) as exc:
+            raise ContentFileError(str(exc)) from None
+        except AnswersError as exc:
+            raise AnswersFileError(str(exc)) from None
+
+    return wrapper  # type: ignore[return-value]
+
+
+def _use_lang(lang: str | None) -> str:
+    """The command's language (``--lang`` here, else the global one); catalogs checked."""
+    lang = lang or get_language()
+    set_language(lang)
+    if lang != "en":
+        for domain in (CONTENT_DOMAIN, "messages"):
+            po = locales_dir() / lang / "LC_MESSAGES" / f"{domain}.po"
+            if po.exists():
+                read_catalog(po, lang)  # a malformed catalog is an error, not a traceback
+    return lang
+
+
+_lang_option = click.option("--lang", type=click.Choice(LANGUAGES), default=None,
+                            help="Language of the quiz and of the messages (en, ur).")
+
+
+@click.group("quiz")
+def quiz_cli() -> None:
+    """Take, score, render and check the chapter's quizzes."""
+
+
+@quiz_cli.command("list")
+@click.option("--json", "as_json", is_flag=True, help="Print JSON for tools.")
+@_errors
+def list_command(as_json: bool) -> None:
+    """List the quizzes with their ids, titles and languages."""
+    entries = list_quizzes()
+    if as_json:
+        click.echo(json.dumps([{"id": e.id, "title": e.title, "languages": list(e.languages)}
+                               for e in entries], ensure_ascii=False, indent=2))
+        return
+    for e in entries:
+        click.echo(f"{e.id}  {e.title}  [{', '.join(e.languages)}]")
+
+
+@quiz_cli.command("lint")
+@_errors
+def lint_command() -> None:
+    """Check every quiz and its translations; print file:line: message for each problem."""
+    from autograder.quiz.lint import lint
+
+    problems = lint()
+    for p in problems:
+        click.echo(str(p), err=True)
+    if problems:
+        raise LintFailed(ngettext("{count} problem found", "{count} problems found",
+                                  len(problems)).format(count=len(problems)))
+    click.echo(_("All quizzes are complete and translated."))
+
+
+@quiz_cli.command("render")
+@click.argument("quizzes", nargs=-1)
+@_lang_option
+@click.option("--format", "fmt", type=click.Choice(["html", "md", "both"]), default="both",
+              show_default=True, help="HTML page, Markdown/MDX for Docusaurus, or both.")
+@click.option("--seed", default=None, help="Shuffle options with this seed.")
+@click.option("--out", "out", type=click.Path(file_okay=False, path_type=Path),
+              default=Path("out/quizzes"), show_default=True, help="Folder to write to.")
+@_errors
+def render_command(quizzes: tuple[str, ...], lang: str | None, fmt: str, seed: str | None,
+                   out: Path) -> None:
+    """Write QUIZ.LANG.html and QUIZ.LANG.mdx (every quiz and language by default)."""
+    files = [find_quiz(q) for q in quizzes] if quizzes else load_all()
+    langs_for = (lambda quiz: (lang,)) if lang else (lambda quiz: quiz.languages)
+    out.mkdir(parents=True, exist_ok=True)
+    for qf in files:
+        for code in langs_for(qf.quiz):
+            _use_lang(code)
+            if fmt in ("html", "both"):
+                path = out / f"{qf.quiz.id}.{code}.html"
+                path.write_text(render_page(qf.quiz, code, seed), encoding="utf-8")
+                click.echo(str(path))
+            if fmt in ("md", "both"):
+                path = out / f"{qf.quiz.id}.{code}.mdx"
+                path.write_text(render_markdown(qf.quiz, code, seed), encoding="utf-8")
+                click.echo(str(path))
+
+
+def _summary(quiz: Quiz, result: RunResult) -> str:
+    """The score in the terminal: per question, then the verdict and the pass mark."""
+    lang = result.lang
+    lines = [result.title, ""]
+    for n, t in enumerate(result.tests, 1):
+        mark = "✔" if t.status == "passed" else "✘"
+        lines.append(f" {mark} {format_number(n, lang)}. {t.message} "
+                     f"({format_number(t.score, lang)}/{format_number(t.max_score, lang)})")
+        if t.status != "passed" and t.hint:
+            lines.append("      " + " ".join(t.hint.split()))
+    verdict = _("Passed") if result.passed else _("Not passed yet")
+    lines += ["", _("{verdict}: {score} of {max_score} ({percent})").format(
+        verdict=verdict, score=format_number(result.score, lang),
+        max_score=format_number(result.max_score, lang),
+        percent=format_percent(result.fraction, lang)), pass_summary(quiz, lang)]
+    return "\n".join(lines)
+
+
+@quiz_cli.command("score")
+@click.argument("quiz")
+@click.argument("answers", type=click.Path(path_type=Path))
+@_lang_option
+@click.option("--results", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="Also write the results JSON here.")
+@click.option("--json", "as_json", is_flag=True, help="Print the results JSON.")
+@_errors
+def score_command(quiz: str, answers: Path, lang: str | None, results: Path | None,
+                  as_json: bool) -> None:
+    """Score a student's ANSWERS file for QUIZ (exit 0 whatever the score)."""
+    lang = _use_lang(lang)
+    qf = find_quiz(quiz)
+    result = score(qf.quiz, read_answers(answers, qf.quiz), lang)
+    data = json.dumps(result_dict(result), ensure_ascii=False, indent=2)
+    if results:
+        results.parent.mkdir(parents=True, exist_ok=True)
+        results.write_text(data + "\n", encoding="utf-8")
+    click.echo(data if as_json else _summary(qf.quiz, result))
+
+
+@quiz_cli.command("key")
+@click.argument("quiz")
+@_errors
+def key_command(quiz: str) -> None:
+    """Print the answers file that scores full marks (for instructors)."""
+    click.echo(json.dumps(key_answers(find_quiz(quiz).quiz), ensure_ascii=False, indent=2))
+
+
+def _ask(q: Any, lang: str) -> Any:
+    """Prompt until the answer parses; Enter skips the question."""
+    n = len(q.options)
+    while True:
+        if q.type == "numeric":
+            raw = click.prompt(_("Your answer (a number, Enter to skip)"), default="",
+                               show_default=False)
+        elif q.type == "multiple":
+            raw = click.prompt(_("Your answers (numbers separated by commas, Enter to skip)"),
+                               default="", show_default=False)
+        elif q.type == "ordering":
+            raw = click.prompt(_("The order (numbers separated by spaces, first one first)"),
+                               default="", show_default=False)
+        else:
+            raw = click.prompt(_("Your answer (1 to {count}, Enter to skip)").format(count=n),
+                               default="", show_default=False)
+        raw = raw.strip()
+        if not raw:
+            return None
+        try:
+            if q.type == "numeric":
+                return float(raw)
+            picks = [int(x) for x in raw.replace(",", " ").split()]
+            if not picks or any(not 1 <= p <= n for p in picks) or len(set(picks)) != len(picks):
+                raise ValueError(raw)
+            ids = [q.options[p - 1].id for p in picks]
+            if q.type in ("single", "true_false"):
+                if len(ids) != 1:
+                    raise ValueError(raw)
+                return ids[0]
+            if q.type == "ordering" and len(ids) != n:
+                raise ValueError(raw)
+            return ids
+        except ValueError:
+            click.echo(_("That is not an answer to this question; try again."), err=True)
+
+
+@quiz_cli.command("take")
+@click.argument("quiz")
+@_lang_option
+@click.option("--seed", default=None, help="Shuffle options with this seed (default: random).")
+@click.option("--save", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="Save your answers file here.")
+@_errors
+def take_command(quiz: str, lang: str | None, seed: str | None, save: Path | None) -> None:
+    """Take QUIZ in the terminal."""
+    import secrets
+
+    lang = _use_lang(lang)
+    qf = find_quiz(quiz)
+    seed = seed if seed is not None else str(secrets.randbelow(10**9))
+    loc = Localizer(qf.quiz, lang)
+    click.echo(terminal(loc.quiz_text("title")))
+    click.echo(pass_summary(qf.quiz, lang))
+    if is_rtl(lang):
+        click.echo(_("Most terminals cannot lay out right-to-left text. For the laid-out page "
+                     "run: autograder quiz serve"))
+    answers: dict[str, Any] = {}
+    for view in question_views(qf.quiz, lang, seed):
+        click.echo("")
+        click.echo(f"{view.number}. {terminal(view.text)}")
+        if view.code:
+            click.echo("\n".join("    " + line for line in view.code.splitlines()))
+        if view.type == "multiple":
+            click.echo(_("Choose all that apply."))
+        for i, o in enumerate(view.options, 1):
+            click.echo(f"  {i}) {terminal(o.text)}")
+        if view.unit:
+            click.echo(f"  [{terminal(view.unit)}]")
+        value = _ask(view, lang)
+        if value is not None:
+            answers[view.id] = value
+    result = score(qf.quiz, answers, lang)
+    click.echo("")
+    click.echo(_summary(qf.quiz, result))
+    if save:
+        save.write_text(json.dumps({"quiz": qf.quiz.id, "seed": seed, "lang": lang,
+                                    "answers": answers}, ensure_ascii=False, indent=2) + "\n",
+                        encoding="utf-8")
+        click.echo(_("Answers saved to {path}").format(path=save))
+
+
+@quiz_cli.command("serve")
+@click.option("--port", type=int, default=8765, show_default=True,
+              help="Port on 127.0.0.1 (0 picks a free one).")
+@_lang_option
+@_errors
+def serve_command(port: int, lang: str | None) -> None:
+    """Serve the quizzes on http://127.0.0.1:PORT/ for a browser."""
+    from autograder.quiz.server import QuizServer
+
+    lang = _use_lang(lang)
+    files = load_all()
+    try:
+        server = QuizServer(files, port, lang)
+    except OSError as exc:
+        raise ServeError(_("cannot listen on 127.0.0.1:{port}: {error}").format(
+            port=port, error=exc.strerror or exc)) from None
+    click.echo(_("Quizzes at {url} (Ctrl-C stops the server)").format(url=server.url))
+    try:
+        server.serve_forever()
+    except KeyboardInterrupt:
+        pass
+    finally:
+        server.server_close()

@@ -1,0 +1,65 @@
+"""``autograder quiz lint``: every problem an instructor must fix before a release.
+
+Quiz files load (ids unique, keys valid), numeric tolerances are sane, and every string
+is translated, not fuzzy, with its placeholders and code unchanged, in every language the
+quiz is offered in.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from autograder.declarative import ContentError
+from autograder.i18n import _, locales_dir
+from autograder.i18n_tools import CatalogError, Problem, check_message, read_catalog
+from autograder.quiz import CONTENT_DOMAIN
+from autograder.quiz.catalog import quiz_paths
+from autograder.quiz.model import QuizFile, check_ids_unique, load_quiz, strings
+
+
+def _problem(exc: ContentError) -> Problem:
+    message = f"{exc.field}: {exc.message}" if exc.field else exc.message
+    return Problem(exc.path, exc.line, message)
+
+
+def _tolerances(qf: QuizFile) -> list[Problem]:
+    problems = []
+    for i, q in enumerate(qf.quiz.questions):
+        if q.type == "numeric" and q.answer and q.tolerance >= abs(q.answer):
+            problems.append(Problem(qf.path, qf.line("questions", i, "tolerance"), _(
+                "questions.{index}.tolerance: a tolerance of {tolerance} around {answer} "
+                "also accepts 0").format(index=i, tolerance=q.tolerance, answer=q.answer)))
+    return problems
+
+
+def lint(root: Path | None = None, locales: Path | None = None) -> list[Problem]:
+    """All problems in the course's quizzes, in file order."""
+    locales = locales or locales_dir()
+    problems: list[Problem] = []
+    files: list[QuizFile] = []
+    for path in quiz_paths(root):
+        try:
+            files.append(load_quiz(path))
+        except ContentError as exc:
+            problems.append(_problem(exc))
+    problems += [_problem(e) for e in check_ids_unique(files)]
+    catalogs: dict[str, object] = {}
+    for qf in files:
+        problems += _tolerances(qf)
+        for lang in qf.quiz.languages:
+            if lang == "en":
+                continue
+            po = locales / lang / "LC_MESSAGES" / f"{CONTENT_DOMAIN}.po"
+            if lang not in catalogs:
+                try:
+                    catalogs[lang] = read_catalog(po, lang)
+                except CatalogError as exc:
+                    catalogs[lang] = None
+                    problems.append(Problem(exc.path, exc.line, exc.message))
+            catalog = catalogs[lang]
+            if catalog is None:
+                continue
+            for s in strings(qf):
+                found = catalog.get(s.text, context=s.context)  # type: ignore[attr-defined]
+                problems += check_message(po, lang, found, s.context, at=(qf.path, s.line))
+    return problems

@@ -1,0 +1,203 @@
+"""What a student receives: an HTML page, a Markdown/MDX export, terminal text.
+
+Everything here is built from *views* that carry no answer key (``question_views``), so
+no renderer can leak it.  HTML comes from autoescaped Jinja2 templates.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from collections.abc import Mapping
+from typing import Any
+
+import jinja2
+from markupsafe import Markup
+
+from autograder.i18n import _, is_rtl, ngettext
+from autograder.quiz.localize import (
+    CODE_SPAN,
+    LATIN_RUN,
+    LRI,
+    PDI,
+    Localizer,
+    Text,
+    format_number,
+    format_percent,
+    plain,
+    rich,
+    using_language,
+)
+from autograder.quiz.model import Quiz
+from autograder.quiz.scoring import pass_summary
+from autograder.quiz.shuffle import option_order
+from autograder.results import RunResult
+
+FONT_STACK_UR = ('"Noto Nastaliq Urdu", "Jameel Noori Nastaleeq", "Urdu Typesetting", '
+                 '"Noto Naskh Arabic", serif')
+
+
+@dataclasses.dataclass(frozen=True)
+class OptionView:
+    id: str
+    text: Text
+
+
+@dataclasses.dataclass(frozen=True)
+class QuestionView:
+    """A question as a student sees it: no key, options in this attempt's order."""
+
+    number: int
+    id: str
+    type: str
+    text: Text
+    code: str
+    unit: Text | None
+    points: int
+    options: tuple[OptionView, ...]
+
+
+def question_views(quiz: Quiz, lang: str, seed: str | int | None) -> list[QuestionView]:
+    loc = Localizer(quiz, lang)
+    views = []
+    for n, q in enumerate(quiz.questions, 1):
+        if q.type == "true_false":
+            options = (OptionView("true", Text(_("True"), lang)),
+                       OptionView("false", Text(_("False"), lang)))
+        else:
+            options = tuple(OptionView(o.id, loc.option(q, o))
+                            for o in option_order(quiz, q, seed))
+        views.append(QuestionView(n, q.id, q.type, loc.text(q, "text"), q.code.rstrip(),
+                                  loc.text(q, "unit") if q.unit else None, q.points, options))
+    return views
+
+
+def _environment() -> jinja2.Environment:
+    env = jinja2.Environment(
+        loader=jinja2.PackageLoader("autograder", "templates"),
+        autoescape=jinja2.select_autoescape(["html"], default=True),
+        trim_blocks=True, lstrip_blocks=True, undefined=jinja2.StrictUndefined)
+    env.globals.update(_=_, ngettext=ngettext, font_stack_ur=Markup(FONT_STACK_UR))
+    env.filters.update(rich=rich, plain=plain)
+    return env
+
+
+_ENV = _environment()
+
+
+def _page_context(quiz: Quiz, lang: str) -> dict[str, Any]:
+    loc = Localizer(quiz, lang)
+    return {
+        "lang": lang,
+        "dir": "rtl" if is_rtl(lang) else "ltr",
+        "quiz_id": quiz.id,
+        "title": loc.quiz_text("title"),
+        "summary": loc.quiz_text("summary") if quiz.summary else None,
+        "pass_summary": pass_summary(quiz, lang),
+    }
+
+
+def render_page(quiz: Quiz, lang: str, seed: str | int | None = None,
+                action: str | None = None, languages: tuple[str, ...] = ()) -> str:
+    """The quiz page; with ``action`` the form posts there, else answers save to a file."""
+    with using_language(lang):
+        return _ENV.get_template("quiz.html").render(
+            **_page_context(quiz, lang), questions=question_views(quiz, lang, seed),
+            seed="" if seed is None else str(seed), action=action,
+            languages=languages or quiz.languages)
+
+
+def render_result(quiz: Quiz, result: RunResult, answers: Mapping[str, Any],
+                  seed: str | int | None = None) -> str:
+    """The page a student sees after submitting: score, verdict, per-question feedback."""
+    lang = result.lang
+    saved = {"quiz": quiz.id, "answers": dict(answers)}
+    if seed is not None:
+        saved["seed"] = seed
+    with using_language(lang):
+        return _ENV.get_template("quiz_result.html").render(
+            **_page_context(quiz, lang), result=result,
+            score=format_number(result.score, lang),
+            max_score=format_number(result.max_score, lang),
+            percent=format_percent(result.fraction, lang),
+            feedback=_feedback(quiz, result),
+            answers_json=json.dumps(saved, ensure_ascii=False, indent=2))
+
+
+def _feedback(quiz: Quiz, result: RunResult) -> list[tuple[Any, Text, Text | None]]:
+    loc = Localizer(quiz, result.lang)
+    rows = []
+    for t in result.tests:
+        q = quiz.question(t.name)
+        assert q is not None, t.name
+        rows.append((t, loc.text(q, "text"),
+                     loc.text(q, "explanation") if q.explanation else None))
+    return rows
+
+
+def render_index(quizzes: list[Quiz], lang: str, languages: tuple[str, ...]) -> str:
+    """The server's home page: pick a language and a quiz."""
+    with using_language(lang):
+        items = [(q, Localizer(q, lang).quiz_text("title")) for q in quizzes]
+        return _ENV.get_template("quiz_index.html").render(
+            lang=lang, dir="rtl" if is_rtl(lang) else "ltr", items=items,
+            languages=languages, title=Text(_("Quizzes"), lang))
+
+
+# Markdown / MDX ---------------------------------------------------------------------------
+
+_MDX_ESCAPES = {"{": "\\{", "}": "\\}", "<": "&lt;", ">": "&gt;", "*": "\\*", "#": "\\#"}
+
+
+def _md_inline(text: Text) -> str:
+    """Markdown for a string: code spans kept; in RTL text, code and Latin runs wrapped in
+    Unicode isolates (markup cannot go inside every Markdown construct)."""
+    rtl = is_rtl(text.lang) and not text.fallback
+    out = []
+    value = " ".join(text.value.split())
+    for i, piece in enumerate(CODE_SPAN.split(value)):
+        if i % 2:
+            out.append(f"{LRI}`{piece}`{PDI}" if rtl else f"`{piece}`")
+            continue
+        escaped = "".join(_MDX_ESCAPES.get(c, c) for c in piece)
+        out.append(LATIN_RUN.sub(lambda m: f"{LRI}{m.group(0)}{PDI}", escaped) if rtl
+                   else escaped)
+    md = "".join(out)
+    if text.fallback:
+        return f'<span lang="en" dir="ltr">{md}</span>'
+    return md
+
+
+def render_markdown(quiz: Quiz, lang: str, seed: str | int | None = None) -> str:
+    """A Markdown/MDX export for a Docusaurus page: questions and options, never the key."""
+    with using_language(lang):
+        ctx = _page_context(quiz, lang)
+        rtl = is_rtl(lang)
+        lines = ["---", f"title: {json.dumps(plain(ctx['title'], False), ensure_ascii=False)}",
+                 "---", ""]
+        if rtl:
+            lines += [f'<div dir="rtl" lang="{lang}">', ""]
+        lines += [f"# {_md_inline(ctx['title'])}", ""]
+        if ctx["summary"]:
+            lines += [_md_inline(ctx["summary"]), ""]
+        lines += [f"**{_md_inline(Text(ctx['pass_summary'], lang))}**", ""]
+        for q in question_views(quiz, lang, seed):
+            lines += [f"## {format_number(q.number, lang)}. {_md_inline(q.text)}", ""]
+            if q.code:
+                block = ["```python", q.code, "```"]
+                lines += (['<div dir="ltr">', "", *block, "", "</div>"] if rtl else block)
+                lines.append("")
+            if q.type == "numeric":
+                unit = f" {_md_inline(q.unit)}" if q.unit else ""
+                lines += [f"{_('Answer:')} \\_\\_\\_\\_\\_\\_{unit}", ""]
+            elif q.type == "ordering":
+                lines += [_("Put these in order:"), ""]
+                lines += [f"- [ ] {_md_inline(o.text)}" for o in q.options] + [""]
+            else:
+                mark = "☐" if q.type == "multiple" else "○"
+                if q.type == "multiple":
+                    lines += [_("Choose all that apply."), ""]
+                lines += [f"- {mark} {_md_inline(o.text)}" for o in q.options] + [""]
+        if rtl:
+            lines += ["</div>", ""]
+        return "\n".join(lines)
