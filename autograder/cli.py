@@ -16,6 +16,7 @@ import click
 from autograder import __version__
 from autograder.declarative import ContentError
 from autograder.i18n import LANGUAGES, _, set_language
+from sim.cli import sim_cli
 
 
 class UsageProblem(click.ClickException):
@@ -193,8 +194,7 @@ def grade_command(exercise: str, submission: Path, results: Path | None, rtf: fl
 
 def _mount_optional() -> None:
     """Mount the command groups that live in their own modules."""
-    for module, attr, name in (("sim.cli", "sim_cli", "sim"),
-                               ("autograder.quiz.cli", "quiz_cli", "quiz"),
+    for module, attr, name in (("autograder.quiz.cli", "quiz_cli", "quiz"),
                                ("autograder.i18n_cli", "i18n_cli", "i18n")):
         try:
             group = getattr(__import__(module, fromlist=[attr]), attr)
@@ -203,4 +203,5 @@ def _mount_optional() -> None:
         main.add_command(group, name)
 
 
+main.add_command(sim_cli, "sim")
 _mount_optional()

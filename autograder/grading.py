@@ -158,4 +158,5 @@ def _result(exercise: Exercise, report: dict[str, Any], returncode: int | None,
         pass_mark=exercise.pass_fraction, lang=get_language(), grader_error=grader_error,
         grader_details=details, log_tail="\n".join(logs.values())[-4000:],
         execution_time=elapsed,
-        data={"recordings": data.get("recordings", {}), "timed_out": timed_out})
+        data={"recordings": data.get("recordings", {}), "timed_out": timed_out,
+              "startup_seconds": data.get("startup_seconds", [])})

@@ -274,6 +274,7 @@ class StudentNode:
         self.process = process
         self.name = name
         self.probe = probe
+        self.startup_seconds: float | None = None
 
     @property
     def returncode(self) -> int | None:
@@ -339,6 +340,8 @@ def launch(request: pytest.FixtureRequest, exercise: Any, script: Path, probe: A
     node = StudentNode(process, exercise.node, probe)
     if wait_for_node:
         _wait_for_node(exercise, node, world)
+        if reporter is not None:
+            reporter.data.setdefault("startup_seconds", []).append(node.startup_seconds)
     return node
 
 
@@ -361,6 +364,7 @@ def _wait_for_node(exercise: Any, node: StudentNode, world: Any) -> None:
 
     world.wait_for(ready, sim_timeout=float("inf"), wall_timeout=exercise.startup_timeout + 1)
     if exercise.node in seen:
+        node.startup_seconds = time.monotonic() - node.process.started_at
         return
     tail = node.output_tail()
     if not node.running():

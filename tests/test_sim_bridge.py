@@ -3,7 +3,6 @@ the robot through /cmd_vel, and the bridge pauses, steps and resets."""
 
 from __future__ import annotations
 
-import fcntl
 import math
 import os
 import subprocess
@@ -28,18 +27,6 @@ from sim.physics import World
 from sim.worldfile import Box, load_world
 
 WALL = 20.0  # generous wall-clock deadline for any one condition
-
-
-def _free_domain() -> tuple[int, object]:
-    """A ROS domain id in 90..100 no other test process holds (a lock file per id)."""
-    for domain in range(90, 101):
-        handle = open(f"/tmp/sim-test-domain-{domain}.lock", "w")  # noqa: SIM115
-        try:
-            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            return domain, handle
-        except OSError:
-            handle.close()
-    pytest.skip("no free ROS domain id between 90 and 100")
 
 
 @dataclass
@@ -72,9 +59,8 @@ class Probe:
 
 
 @pytest.fixture(scope="module")
-def graph() -> Iterator[tuple[SimBridge, Probe]]:
-    os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
-    domain, lock = _free_domain()
+def graph(ros_domain: int) -> Iterator[tuple[SimBridge, Probe]]:
+    domain = ros_domain
     ctx = Context()
     rclpy.init(context=ctx, domain_id=domain)
     bridge = SimBridge(World(load_world("empty_room")), ctx, real_time_factor=2.0)
@@ -107,7 +93,6 @@ def graph() -> Iterator[tuple[SimBridge, Probe]]:
         executor.shutdown()
         probe.node.destroy_node()
         rclpy.try_shutdown(context=ctx)
-        lock.close()  # type: ignore[attr-defined]
 
 
 def test_topics_at_sim_time_rates(graph: tuple[SimBridge, Probe]) -> None:

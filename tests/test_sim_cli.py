@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import os
 from pathlib import Path
 
 from click.testing import CliRunner
@@ -27,11 +26,10 @@ def test_check_good_and_bad(tmp_path: Path) -> None:
     assert f"{bad}:2: radius: unknown field" in result.output
 
 
-def test_run_writes_record_and_svg(tmp_path: Path) -> None:
-    os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+def test_run_writes_record_and_svg(tmp_path: Path, ros_domain: int) -> None:
     record, svg = tmp_path / "run.json", tmp_path / "run.svg"
     result = CliRunner().invoke(sim_cli, [
-        "run", "--world", "corridor", "--rtf", "0", "--duration", "3", "--domain", "101",
+        "run", "--world", "corridor", "--rtf", "0", "--duration", "3", "--domain", str(ros_domain),
         "--record", str(record), "--svg", str(svg), "--seed", "3"])
     assert result.exit_code == 0, result.output
     assert "Goal reached: no" in result.output
