@@ -1,0 +1,84 @@
+"""``autograder quiz serve`` over HTTP (no browser): pages, submit, errors, no key."""
+
+from __future__ import annotations
+
+import threading
+import urllib.error
+import urllib.parse
+import urllib.request
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+from autograder.quiz.catalog import load_all
+from autograder.quiz.server import QuizServer
+
+REPO = Path(__file__).resolve().parent.parent
+
+
+@pytest.fixture
+def server() -> Iterator[QuizServer]:
+    srv = QuizServer(load_all(REPO), port=0)
+    thread = threading.Thread(target=srv.serve_forever, daemon=True)
+    thread.start()
+    yield srv
+    srv.shutdown()
+    srv.server_close()
+    thread.join(timeout=5)
+
+
+def _get(url: str) -> str:
+    with urllib.request.urlopen(url, timeout=5) as resp:
+        return resp.read().decode()
+
+
+def _post(url: str, fields: list[tuple[str, str]]) -> tuple[int, str]:
+    data = urllib.parse.urlencode(fields).encode()
+    try:
+        with urllib.request.urlopen(url, data=data, timeout=5) as resp:
+            return resp.status, resp.read().decode()
+    except urllib.error.HTTPError as exc:
+        return exc.code, exc.read().decode()
+
+
+def test_binds_loopback_on_a_free_port(server: QuizServer) -> None:
+    host, port = server.server_address[:2]
+    assert host == "127.0.0.1" and port > 0
+    assert "rclpy-part2" in _get(server.url)
+
+
+def test_urdu_page_and_submit(server: QuizServer) -> None:
+    page = _get(server.url + "quiz/rclpy-part2/?lang=ur")
+    assert '<html lang="ur" dir="rtl">' in page and 'action="submit"' in page
+    assert "cpython-lock" in page  # option ids are there, which one is right is not
+    fields = [("lang", "ur"), ("seed", "3"), ("q:callback-groups-purpose", "concurrency"),
+              ("q:declare-parameters", "declare"), ("q:gil", "cpython-lock"),
+              ("q:shared-resources", "mutually-exclusive"), ("q:python-advantage", "faster")]
+    status, result = _post(server.url + "quiz/rclpy-part2/submit", fields)
+    assert status == 200
+    assert 'id="verdict"' in result and "کامیاب" in result and "ابھی کامیاب نہیں" not in result
+    assert "5 میں سے 4 (80%)" in result
+    assert "پاسنگ اسکور: 70% (4/5 سوالات)" in result
+    assert "download=\"answers.json\"" in result
+
+
+def test_ordering_numeric_and_multiple_from_the_form(server: QuizServer) -> None:
+    fields = [("lang", "en"), ("q:period-units", "seconds"), ("q:calls-in-two-seconds", "۸"),
+              ("q:keep-in-step", "same-group"), ("q:keep-in-step", "lock")]
+    status, page = _post(server.url + "quiz/timer-synchronization/submit", fields)
+    assert status == 200 and page.count("Correct.") == 2  # Urdu digits parse as numbers
+    assert "Partly correct: 0.67 of 1 points." in page
+    order = [("q:life-order:init", "1"), ("q:life-order:create", "2"),
+             ("q:life-order:spin", "3"), ("q:life-order:destroy", "4"),
+             ("q:life-order:shutdown", "5")]
+    status, page = _post(server.url + "quiz/error-handling/submit", order)
+    assert status == 200 and page.count("Correct.") == 1
+
+
+def test_bad_form_is_a_400_naming_the_problem(server: QuizServer) -> None:
+    status, page = _post(server.url + "quiz/rclpy-part2/submit", [("q:gil", "gvl")])
+    assert status == 400 and "question &#39;gil&#39; has no option &#39;gvl&#39;" in page
+    with pytest.raises(urllib.error.HTTPError) as info:
+        _get(server.url + "quiz/nope/")
+    assert info.value.code == 404
