@@ -38,7 +38,8 @@ def _po(course: Path) -> Path:
 
 def _set_msgstr(po: Path, context: str, new: str, fuzzy: bool = False) -> None:
     text = po.read_text()
-    pattern = rf'(#, fuzzy\n)?(msgctxt "{re.escape(context)}"\nmsgid (?:"[^\n]*"\n)+)msgstr (?:"[^\n]*"\n)+'
+    entry = rf'msgctxt "{re.escape(context)}"\nmsgid (?:"[^\n]*"\n)+'
+    pattern = rf'(#, fuzzy\n)?({entry})msgstr (?:"[^\n]*"\n)+'
     flag = "#, fuzzy\n" if fuzzy else ""
     text, n = re.subn(pattern, lambda m: f'{flag}{m.group(2)}msgstr "{new}"\n', text)
     assert n == 1, context
@@ -89,10 +90,10 @@ def test_malformed_quiz_and_duplicate_ids_and_tolerance(course: Path) -> None:
     (folder / "broken.yaml").write_text("id: broken\ntitle: [\n")
     code, lines = _lint()
     assert code == 1
-    assert any(l.startswith(f"{folder / 'broken.yaml'}:3: YAML error") for l in lines)
-    assert any("quiz id 'rclpy-part2' is also used by" in l for l in lines)
-    assert any(re.search(r"timer-synchronization.yaml:\d+: questions.1.tolerance", l)
-               for l in lines)
+    assert any(line.startswith(f"{folder / 'broken.yaml'}:3: YAML error") for line in lines)
+    assert any("quiz id 'rclpy-part2' is also used by" in line for line in lines)
+    assert any(re.search(r"timer-synchronization.yaml:\d+: questions.1.tolerance", line)
+               for line in lines)
 
 
 def test_malformed_catalog_is_one_line_naming_it(course: Path) -> None:
@@ -100,7 +101,7 @@ def test_malformed_catalog_is_one_line_naming_it(course: Path) -> None:
     po.write_text(po.read_text().replace('msgstr "', 'msgstr "\n"unterminated', 1) + 'msgid "x\n')
     code, lines = _lint()
     assert code == 1
-    assert any(l.startswith(f"{po}:") and "malformed catalog" in l for l in lines)
+    assert any(line.startswith(f"{po}:") and "malformed catalog" in line for line in lines)
     answers = course / "a.json"
     answers.write_text('{"quiz": "rclpy-part2", "answers": {}}')
     result = CliRunner().invoke(quiz_cli, ["score", "rclpy-part2", str(answers), "--lang", "ur"])

@@ -61,8 +61,12 @@ def _errors(func: F) -> F:
 
 def _use_lang(lang: str | None) -> str:
     """The command's language (``--lang`` here, else the global one); catalogs checked."""
-    lang = lang or get_language()
+    before = get_language()
+    lang = lang or before
     set_language(lang)
+    ctx = click.get_current_context(silent=True)
+    if ctx is not None:  # restore when the command ends (matters when invoked in-process)
+        ctx.call_on_close(lambda: set_language(before))
     if lang != "en":
         for domain in (CONTENT_DOMAIN, "messages"):
             po = locales_dir() / lang / "LC_MESSAGES" / f"{domain}.po"

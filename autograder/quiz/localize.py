@@ -24,8 +24,8 @@ from autograder.quiz.model import Option, Question, Quiz, context, is_code_only
 
 CODE_SPAN = re.compile(r"`([^`]+)`")
 # A run of Latin-script words (identifiers, English terms) inside right-to-left text.
-LATIN_RUN = re.compile(r"[A-Za-z_][\w.()\[\]/+=-]*(?:[ ,][ ]?[A-Za-z_][\w.()\[\]/+=-]*)*",
-                       re.ASCII)
+_WORD = r"[\w./+=-]*(?:\(\))?"
+LATIN_RUN = re.compile(rf"[A-Za-z_]{_WORD}(?: [A-Za-z0-9_]{_WORD})*", re.ASCII)
 FSI, LRI, PDI = "\u2068", "\u2066", "\u2069"
 
 

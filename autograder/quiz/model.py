@@ -86,7 +86,8 @@ class Quiz:
 
     id: str = dataclasses.field(default="", metadata=_doc("Stable id, unique in the course."))
     title: str = dataclasses.field(default="", metadata=_doc("Title students see."))
-    summary: str = dataclasses.field(default="", metadata=_doc("One or two lines on what it covers."))
+    summary: str = dataclasses.field(default="", metadata=_doc(
+        "One or two lines on what it covers."))
     pass_mark: float = dataclasses.field(default=0.7, metadata=_doc(
         "Fraction of the points needed to pass: 0.7 is 70%."))
     languages: tuple[str, ...] = dataclasses.field(default=("en", "ur"), metadata=_doc(

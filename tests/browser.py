@@ -1,0 +1,91 @@
+"""Headless Chromium for tests: Debian's ``chromium`` driven by Playwright's Python package.
+
+No browser is ever downloaded: Playwright gets Debian's executable.  Tests skip with a
+clear reason when Chromium or the playwright package is absent.
+"""
+
+from __future__ import annotations
+
+import base64
+import contextlib
+import shutil
+import tempfile
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+CHROMIUM_FLAGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+                  "--disable-background-networking", "--disable-component-update",
+                  "--disable-sync"]
+
+
+def chromium_path() -> str | None:
+    for candidate in (shutil.which("chromium"), "/usr/bin/chromium"):
+        if candidate and Path(candidate).exists():
+            return candidate
+    return None
+
+
+def skip_without_browser() -> str:
+    """Chromium's path, or skip the test saying what to install."""
+    path = chromium_path()
+    if path is None:
+        pytest.skip("Chromium is not installed: apt-get install chromium fonts-noto-core "
+                    "(CI's .ci/run does this)")
+    try:
+        import playwright.sync_api  # noqa: F401
+    except ImportError:
+        pytest.skip("the playwright Python package is not installed: pip install playwright "
+                    "(it drives Debian's Chromium; never run 'playwright install')")
+    return path
+
+
+@contextlib.contextmanager
+def chromium_page(width: int = 900, height: int = 1200) -> Iterator[Any]:
+    """A page in a fresh headless Chromium profile, closed afterwards."""
+    executable = skip_without_browser()
+    from playwright.sync_api import sync_playwright
+
+    with tempfile.TemporaryDirectory(prefix="chromium-profile-") as profile, \
+            sync_playwright() as p:
+        context = p.chromium.launch_persistent_context(
+            profile, executable_path=executable, headless=True, args=CHROMIUM_FLAGS,
+            viewport={"width": width, "height": height}, locale="ur-PK")
+        try:
+            page = context.pages[0] if context.pages else context.new_page()
+            page.set_default_timeout(15_000)
+            yield page
+        finally:
+            context.close()
+
+
+_INK_JS = """
+async ([data, box]) => {
+  const img = new Image();
+  img.src = "data:image/png;base64," + data;
+  await img.decode();
+  const canvas = document.createElement("canvas");
+  canvas.width = img.width; canvas.height = img.height;
+  const ctx = canvas.getContext("2d");
+  ctx.drawImage(img, 0, 0);
+  const [x0, y0, w, h] = box || [0, 0, img.width, img.height];
+  const px = ctx.getImageData(x0, y0, w, h).data;
+  let ink = 0, left = w, right = -1;
+  for (let y = 0; y < h; y++) for (let x = 0; x < w; x++) {
+    const i = (y * w + x) * 4;
+    if (px[i] + px[i + 1] + px[i + 2] < 600) {
+      ink++; left = Math.min(left, x); right = Math.max(right, x);
+    }
+  }
+  return {ink, left, right, width: w, height: h};
+}
+"""
+
+
+def ink(page: Any, png: bytes, box: tuple[int, int, int, int] | None = None) -> dict[str, int]:
+    """Dark pixels in a screenshot (or a box of it), counted by the browser's own canvas."""
+    data = base64.b64encode(png).decode()
+    page.goto("about:blank")
+    return page.evaluate(_INK_JS, [data, list(box) if box else None])

@@ -1,0 +1,106 @@
+"""The quiz in headless Chromium: the server end to end, and the Urdu page as rendered."""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+from browser import chromium_page, ink
+
+from autograder.quiz.catalog import load_all
+from autograder.quiz.model import load_quiz
+from autograder.quiz.render import render_page
+from autograder.quiz.server import QuizServer
+
+REPO = Path(__file__).resolve().parent.parent
+SCREENSHOT = Path("/tmp/quiz-rclpy-part2-ur.png")
+
+
+@pytest.fixture
+def server() -> Iterator[QuizServer]:
+    srv = QuizServer(load_all(REPO), port=0)
+    thread = threading.Thread(target=srv.serve_forever, daemon=True)
+    thread.start()
+    yield srv
+    srv.shutdown()
+    srv.server_close()
+    thread.join(timeout=5)
+
+
+def test_serve_pick_urdu_answer_submit_see_verdict(server: QuizServer) -> None:
+    with chromium_page() as page:
+        page.goto(server.url)
+        page.click('a[hreflang="ur"]')
+        page.wait_for_url("**/?lang=ur")
+        page.click('a[href^="/quiz/rclpy-part2/"]')
+        assert page.get_attribute("html", "lang") == "ur"
+        assert page.get_attribute("html", "dir") == "rtl"
+        # Radio buttons sit on the right of their text in RTL.
+        label = page.locator('label.option:has(input[value="cpython-lock"])')
+        radio = label.locator("input").bounding_box()
+        text = label.locator("span").bounding_box()
+        assert radio["x"] > text["x"] + text["width"] - 1
+        for name, value in [("callback-groups-purpose", "concurrency"),
+                            ("declare-parameters", "declare"), ("gil", "cpython-lock"),
+                            ("shared-resources", "reentrant"), ("python-advantage", "rapid")]:
+            page.check(f'input[name="q:{name}"][value="{value}"]')
+        page.click("#submit")
+        verdict = page.locator("#verdict")
+        verdict.wait_for()
+        assert "کامیاب" in verdict.inner_text() and "ابھی" not in verdict.inner_text()
+        assert "5 میں سے 4 (80%)" in verdict.inner_text()
+        assert page.locator("#feedback-shared-resources .status-failed").inner_text() == "غلط۔"
+        assert page.get_attribute("html", "dir") == "rtl"
+
+
+_LAYOUT_JS = """
+() => {
+  const rect = (el) => el.getBoundingClientRect();
+  const textRect = (el) => { const r = document.createRange(); r.selectNodeContents(el);
+                             return r.getBoundingClientRect(); };
+  const out = [];
+  const selector = "h1, .summary, .pass-mark, .question .text, label.option span";
+  for (const el of document.querySelectorAll(selector)) {
+    const c = rect(el), t = textRect(el);
+    out.push({sel: el.id || el.className || el.tagName, cl: c.left, cr: c.right, ct: c.top,
+              cb: c.bottom, tl: t.left, tr: t.right, tt: t.top, tb: t.bottom,
+              overflow: el.scrollHeight - el.clientHeight});
+  }
+  const body = getComputedStyle(document.body);
+  const code = document.querySelector(".question code");
+  return {items: out, font: body.fontFamily, lineHeight: body.lineHeight,
+          fontSize: body.fontSize, direction: body.direction,
+          nastaliq: document.fonts.check('20px "Noto Nastaliq Urdu"', "کیا"),
+          codeDirection: getComputedStyle(code).direction,
+          codeUnicodeBidi: getComputedStyle(code).unicodeBidi};
+}
+"""
+
+
+def test_urdu_page_renders_rtl_in_nastaliq_unclipped(tmp_path: Path) -> None:
+    quiz = load_quiz(REPO / "quizzes" / "part2-rclpy.yaml").quiz
+    html = tmp_path / "rclpy-part2.ur.html"
+    html.write_text(render_page(quiz, "ur", seed=7), encoding="utf-8")
+    with chromium_page() as page:
+        page.goto(html.as_uri())
+        page.evaluate("document.fonts.ready")
+        layout = page.evaluate(_LAYOUT_JS)
+        png = page.screenshot(full_page=True, path=str(SCREENSHOT))
+        title = page.locator("h1").bounding_box()
+        stats = ink(page, png)
+        title_ink = ink(page, png, (0, int(title["y"]), 900, int(title["height"])))
+    assert layout["direction"] == "rtl"
+    assert layout["font"].startswith('"Noto Nastaliq Urdu"')
+    assert layout["nastaliq"], "Noto Nastaliq Urdu is not available (fonts-noto-core)"
+    assert (layout["codeDirection"], layout["codeUnicodeBidi"]) == ("ltr", "isolate")
+    for item in layout["items"]:
+        # Right-aligned: each line starts at its container's right edge.
+        assert abs(item["cr"] - item["tr"]) < 3, item
+        # Not clipped: the glyphs' box lies within the container's, nothing overflows.
+        assert item["tt"] >= item["ct"] - 1 and item["tb"] <= item["cb"] + 1, item
+        assert item["overflow"] <= 0, item
+    # Not blank, and the title's ink hugs the right side of the page.
+    assert stats["ink"] > 20_000
+    assert title_ink["right"] > 900 * 0.85 and title_ink["left"] > 900 * 0.2
