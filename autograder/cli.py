@@ -16,6 +16,8 @@ import click
 from autograder import __version__
 from autograder.declarative import ContentError
 from autograder.i18n import LANGUAGES, _, set_language
+from autograder.i18n_cli import i18n_cli
+from autograder.quiz.cli import quiz_cli
 from sim.cli import sim_cli
 
 
@@ -83,7 +85,7 @@ def list_command(as_json: bool) -> None:
         return
     click.echo(_("Exercises:"))
     for e in exercises:
-        click.echo(f"  {e.id:<24} {_(e.title)}")
+        click.echo(f"  {e.id:<24} {e.localized_title}")
     if quizzes:
         click.echo(_("Quizzes:"))
         for q in quizzes:
@@ -91,10 +93,8 @@ def list_command(as_json: bool) -> None:
 
 
 def _quizzes() -> list:
-    try:
-        from autograder.quiz.catalog import list_quizzes
-    except ImportError:
-        return []
+    from autograder.quiz.catalog import list_quizzes
+
     try:
         return list_quizzes()
     except ContentError as exc:
@@ -192,16 +192,6 @@ def grade_command(exercise: str, submission: Path, results: Path | None, rtf: fl
     _run(exercise, submission, True, results, rtf, domain)
 
 
-def _mount_optional() -> None:
-    """Mount the command groups that live in their own modules."""
-    for module, attr, name in (("autograder.quiz.cli", "quiz_cli", "quiz"),
-                               ("autograder.i18n_cli", "i18n_cli", "i18n")):
-        try:
-            group = getattr(__import__(module, fromlist=[attr]), attr)
-        except (ImportError, AttributeError):
-            continue
-        main.add_command(group, name)
-
-
 main.add_command(sim_cli, "sim")
-_mount_optional()
+main.add_command(quiz_cli, "quiz")
+main.add_command(i18n_cli, "i18n")

@@ -9,7 +9,7 @@ from typing import Literal
 
 from autograder.course import course_root
 from autograder.declarative import ContentError, build, load_document
-from autograder.i18n import _
+from autograder.i18n import _, content_text
 
 
 def _doc(text: str) -> dict[str, str]:
@@ -68,6 +68,11 @@ class Exercise:
     def __post_init__(self) -> None:
         if not 0 < self.pass_mark <= 1:
             raise ValueError(_("pass_mark must be above 0 and at most 1"))
+
+    @property
+    def localized_title(self) -> str:
+        """The title in the active language (``content`` catalog, ``exercise:<id>:title``)."""
+        return content_text(f"exercise:{self.id}:title", self.title)
 
     @property
     def pass_fraction(self) -> Fraction:

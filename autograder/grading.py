@@ -154,7 +154,7 @@ def _result(exercise: Exercise, report: dict[str, Any], returncode: int | None,
     data = report.get("data", {})
     logs = data.get("logs", {})
     return RunResult(
-        kind="exercise", id=exercise.id, title=_(exercise.title), tests=tuple(tests),
+        kind="exercise", id=exercise.id, title=exercise.localized_title, tests=tuple(tests),
         pass_mark=exercise.pass_fraction, lang=get_language(), grader_error=grader_error,
         grader_details=details, log_tail="\n".join(logs.values())[-4000:],
         execution_time=elapsed,

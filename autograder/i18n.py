@@ -81,6 +81,11 @@ def pgettext(context: str, message: str) -> str:
     return translations(_active).pgettext(context, message)
 
 
+def content_text(context: str, message: str) -> str:
+    """Course content (quiz and exercise text) from the ``content`` domain, by context."""
+    return translations(_active, "content").pgettext(context, message)
+
+
 def N_(message: str) -> str:
     """Mark ``message`` for extraction without translating it yet (translated when shown)."""
     return message

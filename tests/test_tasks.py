@@ -13,5 +13,6 @@ def test_non_ros_dependencies_match_pyproject():
     block = text.split("dependencies = [", 1)[1].split("]\n", 1)[0]
     declared = set(re.findall(r'^\s*"([^"]+)"', block, re.M))
     ros = {d for d in declared if d.startswith("ros-jazzy-")}
-    dev = set(re.findall(r'dev = \["([^"]+)"\]', text))
+    dev_block = text.split("dev = [", 1)[1].split("]\n", 1)[0]
+    dev = set(re.findall(r'^\s*"([^"]+)"', dev_block, re.M))
     assert set(tasks.NON_ROS_DEPENDENCIES) == declared - ros | dev

@@ -7,8 +7,8 @@ from pathlib import Path
 
 from autograder.course import course_root
 from autograder.declarative import ContentError
-from autograder.i18n import _
-from autograder.quiz.model import QuizFile, load_quiz
+from autograder.i18n import _, content_text
+from autograder.quiz.model import QuizFile, context, load_quiz
 
 
 @dataclasses.dataclass(frozen=True)
@@ -51,6 +51,7 @@ def find_quiz(name: str, root: Path | None = None) -> QuizFile:
 
 
 def list_quizzes(root: Path | None = None) -> list[QuizEntry]:
-    """Quizzes for ``autograder list --json``: id, title and languages."""
-    return [QuizEntry(qf.quiz.id, qf.quiz.title, qf.quiz.languages, qf.path)
+    """Quizzes for ``autograder list --json``: id, title (in the active language), languages."""
+    return [QuizEntry(qf.quiz.id, content_text(context(qf.quiz.id, "title"), qf.quiz.title),
+                      qf.quiz.languages, qf.path)
             for qf in load_all(root)]
