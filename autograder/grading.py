@@ -119,6 +119,15 @@ def _reap(child: subprocess.Popen[bytes], report: dict[str, Any]) -> None:
             group.remove()
 
 
+def _score(status: str, max_score: Fraction, fraction: float | None) -> Fraction:
+    """Full points for a pass; a failed test's partial credit, rounded to 1/100 of a point."""
+    if status == "passed":
+        return max_score
+    if fraction:
+        return Fraction(round(fraction * max_score * 100), 100)
+    return Fraction(0)
+
+
 def _result(exercise: Exercise, report: dict[str, Any], returncode: int | None,
             timed_out: bool, pytest_log: str, elapsed: float) -> RunResult:
     tests = []
@@ -135,7 +144,7 @@ def _result(exercise: Exercise, report: dict[str, Any], returncode: int | None,
             errors.append(f"{raw['name']}: {message}\n{raw.get('details', '')}")
         tests.append(TestResult(
             name=raw["name"], label=raw["label"],
-            score=max_score if status == "passed" else Fraction(0), max_score=max_score,
+            score=_score(status, max_score, raw.get("fraction")), max_score=max_score,
             status=status, message=message, hint=raw.get("hint", ""),
             visibility=raw["visibility"], details=raw.get("details", "")))
     grader_error = None

@@ -28,6 +28,7 @@ from autograder.errors import GraderError, StudentFailure
 from autograder.i18n import _, set_language
 
 reporter_key = pytest.StashKey["GradingReporter"]()
+credit_key = pytest.StashKey["Credit"]()
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:
@@ -128,7 +129,12 @@ class GradingReporter:
         if entry is None:
             return
         if call.when == "setup" or call.when == "call":
-            if report.passed and call.when == "call":
+            given = item.stash.get(credit_key, None)
+            if report.passed and call.when == "call" and given and given.fraction is not None \
+                    and given.fraction < 1:
+                entry.update(status="failed", fraction=given.fraction, message=given.message,
+                             hint=given.hint)
+            elif report.passed and call.when == "call":
                 entry.update(status="passed", message="", hint="")
             elif report.skipped:
                 entry.update(status="skipped", message=_skip_reason(report))
@@ -168,6 +174,31 @@ def _classify(excinfo: pytest.ExceptionInfo[BaseException] | None) -> dict[str, 
 
 
 # -- fixtures -------------------------------------------------------------------------------
+
+class Credit:
+    """Partial credit for the running test: ``credit.award(fraction, message)``.
+
+    A test that awards less than 1 and returns normally is reported as failed with
+    ``fraction`` of its points and the message; without an award, pass/fail decides.
+    """
+
+    def __init__(self) -> None:
+        self.fraction: float | None = None
+        self.message = ""
+        self.hint = ""
+
+    def award(self, fraction: float, message: str = "", hint: str = "") -> None:
+        self.fraction = min(1.0, max(0.0, fraction))
+        self.message, self.hint = message, hint
+
+
+@pytest.fixture
+def credit(request: pytest.FixtureRequest) -> Credit:
+    """Give this test partial credit (see :class:`Credit`)."""
+    given = Credit()
+    request.node.stash[credit_key] = given
+    return given
+
 
 @pytest.fixture(scope="session")
 def exercise(pytestconfig: pytest.Config) -> Any:
@@ -243,7 +274,7 @@ def world(request: pytest.FixtureRequest, exercise: Any, ros_context: Any) -> It
     local = exercise.folder / name
     spec = load_world(local if local.suffix in (".yaml", ".yml") and local.exists() else name)
     rtf = request.config.getoption("real_time_factor")
-    bridge = SimBridge(World(spec), ros_context,
+    bridge = SimBridge(World(spec), ros_context, max_clock_hz=exercise.clock_hz,
                        real_time_factor=exercise.real_time_factor if rtf is None else rtf)
     bridge.start()
     try:
@@ -290,10 +321,17 @@ class StudentNode:
         return self.process.output_tail(lines)
 
     def wait_exit(self, wall_timeout: float) -> int | None:
+        """Wait (wall time: exiting is the process's business) for it to end; its status."""
         return self.process.wait(wall_timeout)
 
+    def send_signal(self, sig: int) -> None:
+        """Signal the program's process group, as Ctrl-C in its terminal would."""
+        self.process.signal(sig)
+
     def stop(self) -> int | None:
-        return self.process.stop()
+        status = self.process.stop()
+        self.probe.world.unwatch_pid(self.process.pid)
+        return status
 
 
 def _describe_exit(code: int) -> str:
@@ -397,7 +435,6 @@ def student(request: pytest.FixtureRequest, exercise: Any, submission_file: Path
         yield node
     finally:
         node.stop()
-        world.watch_pid(None)
         _keep_log(request, node)
 
 
@@ -418,7 +455,6 @@ def start_node(request: pytest.FixtureRequest, exercise: Any, submission_file: P
         for node in started:
             node.stop()
             _keep_log(request, node)
-        world.watch_pid(None)
 
 
 def _keep_log(request: pytest.FixtureRequest, node: StudentNode) -> None:

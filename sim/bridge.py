@@ -97,7 +97,7 @@ class SimBridge:
         self._cond = threading.Condition(threading.RLock())
         self._paused = False
         self._running = False
-        self._pid: int | None = None
+        self._pids: set[int] = set()
         self._cmd: tuple[float, float] | None = None
         self._window: collections.deque[tuple[float, float]] = collections.deque(maxlen=100)
         self._threads: list[threading.Thread] = []
@@ -172,10 +172,18 @@ class SimBridge:
             self.sim.inject(fault)
 
     def watch_pid(self, pid: int | None) -> None:
-        """Hold sim time back while process ``pid`` has work to do (None: watch nothing)."""
+        """Also hold sim time back while process ``pid`` has work (None: watch nothing)."""
         with self._cond:
-            self._pid = pid
+            if pid is None:
+                self._pids.clear()
+            else:
+                self._pids.add(pid)
             self._window.clear()
+
+    def unwatch_pid(self, pid: int) -> None:
+        """Stop watching process ``pid``."""
+        with self._cond:
+            self._pids.discard(pid)
 
     # -- observing ------------------------------------------------------------------
     @property
@@ -265,15 +273,15 @@ class SimBridge:
                 start = now  # late: no catch-up burst, sim time just runs slower
 
     def _wait_quiescent(self, published: float, deadline: float) -> None:
-        pid = self._pid
-        if pid is None:
+        pids = tuple(self._pids)
+        if not pids:
             return
         first = published + self.settle
         now = time.monotonic()
         if now < min(first, deadline):
             time.sleep(min(first, deadline) - now)
         cap = published + self.quiescence_cap
-        while process_busy(pid) and time.monotonic() < cap:
+        while any(process_busy(pid) for pid in pids) and time.monotonic() < cap:
             time.sleep(self.poll_interval)
 
     def _tick(self, steps: int) -> None:
