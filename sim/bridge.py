@@ -19,9 +19,13 @@ Commands received on ``/cmd_vel`` take effect at the start of the next tick.
   There is no catch-up: a late tick moves the schedule, so sim time just runs slower.
 * **Quiescence.**  With a watched process (``watch_pid``, the student's node), the bridge
   then waits until none of its threads is running or runnable (state ``R`` in
-  ``/proc/<pid>/task/*/stat``), polling every ``poll_interval`` and giving up after
-  ``quiescence_cap`` of wall time per tick.  A student process that cannot get a CPU thus
-  holds sim time back, and one that busy-loops only slows the world down.
+  ``/proc/<pid>/task/*/stat``), or until it has used ``cpu_budget`` (50 ms) of CPU time
+  since the tick (``/proc/<pid>/task/*/schedstat``), polling every ``poll_interval``, with
+  ``quiescence_cap`` (2 s) of wall time as the last resort.  A student process that
+  cannot get a CPU on a busy machine thus holds sim time back however long it waits,
+  while one that busy-loops has had its share after 50 ms of CPU and only slows the
+  world down.  (A wall-time cap alone, tried first, let sim time run on while a starved
+  process waited for a CPU, and a correct node then failed under load.)
 * ``effective_rtf`` reports the measured sim seconds per wall second of the last ticks.
 
 Physics runs in one thread and the executor (for /cmd_vel) in another; the world is
@@ -61,18 +65,29 @@ def _stamp(t: float) -> tuple[int, int]:
 
 def process_busy(pid: int) -> bool:
     """True if any thread of ``pid`` is running or runnable; False if idle or gone."""
+    return process_state(pid)[0]
+
+
+def process_state(pid: int) -> tuple[bool, int]:
+    """(any thread running or runnable, CPU nanoseconds used by all its threads so far).
+
+    CPU time comes from ``/proc/<pid>/task/*/schedstat`` (nanoseconds on the CPU), so a
+    thread that is runnable but starved of a CPU is told apart from one that computes.
+    """
     try:
         tasks = list(Path(f"/proc/{pid}/task").iterdir())
     except OSError:
-        return False
+        return False, 0
+    busy, cpu = False, 0
     for task in tasks:
         try:
             stat = (task / "stat").read_bytes()
-        except OSError:
+            cpu += int((task / "schedstat").read_bytes().split()[0])
+        except (OSError, ValueError, IndexError):
             continue
         if stat[stat.rindex(b")") + 2:stat.rindex(b")") + 3] == b"R":
-            return True
-    return False
+            busy = True
+    return busy, cpu
 
 
 class SimBridge:
@@ -80,7 +95,8 @@ class SimBridge:
 
     def __init__(self, world: World, context: Context, *, real_time_factor: float = 1.0,
                  max_clock_hz: float = 50.0, node_name: str = "sim_world",
-                 quiescence_cap: float = 0.05, poll_interval: float = 0.0005,
+                 quiescence_cap: float = 2.0, cpu_budget: float = 0.05,
+                 poll_interval: float = 0.0005,
                  settle: float = 0.001, max_tick: float = 2.0) -> None:
         if real_time_factor < 0 or max_clock_hz <= 0:
             raise ValueError("real_time_factor must be >= 0 and max_clock_hz > 0")
@@ -88,6 +104,7 @@ class SimBridge:
         self.world = world
         self.max_clock_hz = max_clock_hz
         self.quiescence_cap = quiescence_cap
+        self.cpu_budget = cpu_budget
         self.poll_interval = poll_interval
         self.settle = settle
         self.max_tick = max_tick
@@ -273,6 +290,12 @@ class SimBridge:
                 start = now  # late: no catch-up burst, sim time just runs slower
 
     def _wait_quiescent(self, published: float, deadline: float) -> None:
+        """Hold the next tick until every watched process is idle or has had its CPU share.
+
+        A process that keeps computing is let go once it has used ``cpu_budget`` seconds of
+        CPU since the tick (it is busy, not slow); one that is runnable but gets no CPU (a
+        busy machine) holds sim time back, up to ``quiescence_cap`` of wall time.
+        """
         pids = tuple(self._pids)
         if not pids:
             return
@@ -280,8 +303,18 @@ class SimBridge:
         now = time.monotonic()
         if now < min(first, deadline):
             time.sleep(min(first, deadline) - now)
+        start = {pid: process_state(pid)[1] for pid in pids}
+        budget = int(self.cpu_budget * 1e9)
         cap = published + self.quiescence_cap
-        while any(process_busy(pid) for pid in pids) and time.monotonic() < cap:
+        while time.monotonic() < cap:
+            waiting = False
+            for pid in pids:
+                busy, cpu = process_state(pid)
+                if busy and cpu - start[pid] < budget:
+                    waiting = True
+                    break
+            if not waiting:
+                return
             time.sleep(self.poll_interval)
 
     def _tick(self, steps: int) -> None:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 import os
+import shutil
 import subprocess
 import sys
 import threading
@@ -157,6 +158,7 @@ def test_watched_process_paces_sim_time(graph: tuple[SimBridge, Probe]) -> None:
     try:
         bridge.watch_pid(busy.pid)
         slowed = _rtf_over(bridge, 0.4)
+        bridge.unwatch_pid(busy.pid)
         bridge.watch_pid(idle.pid)
         free = _rtf_over(bridge, 0.4)
     finally:
@@ -164,9 +166,31 @@ def test_watched_process_paces_sim_time(graph: tuple[SimBridge, Probe]) -> None:
         for proc in (busy, idle):
             proc.kill()
             proc.wait()
-    # A tick is 0.02 s of sim time and may wait up to 0.05 s of wall time for quiescence.
+    # A tick is 0.02 s of sim time; a busy process gets 0.05 s of CPU before it passes.
     assert slowed < 0.6, slowed
     assert free > 0.85, free
+
+
+@pytest.mark.skipif(os.geteuid() != 0 or shutil.which("taskset") is None,
+                    reason="needs root (nice -20) and taskset to starve a process")
+def test_starved_process_holds_sim_time(graph: tuple[SimBridge, Probe]) -> None:
+    """A process that is runnable but gets no CPU (a busy machine) holds sim time back."""
+    bridge, _ = graph
+    bridge.set_real_time_factor(1.0)
+    spin = [sys.executable, "-c", "while True: pass"]
+    # Both on CPU 0; the hog at nice -20, the "student" at nice 19 gets ~1% of the CPU.
+    hog = subprocess.Popen(["taskset", "-c", "0", "nice", "-n", "-20", *spin])
+    starved = subprocess.Popen(["taskset", "-c", "0", "nice", "-n", "19", *spin])
+    try:
+        bridge.watch_pid(starved.pid)
+        held = _rtf_over(bridge, 0.1)
+    finally:
+        bridge.unwatch_pid(starved.pid)
+        for proc in (hog, starved):
+            proc.kill()
+            proc.wait()
+    # With a 0.05 s wall cap this ran at ~0.4x; with the CPU budget it nearly stops.
+    assert held < 0.1, held
 
 
 STUDENT = """
