@@ -123,10 +123,9 @@ def start(exercise: str, directory: Path | None) -> None:
         file=target / found.file, exercise=found.id))
 
 
-def _run(exercise: str, submission: Path, hidden: bool, results: Path | None,
+def _run(exercise: str, submission: Path, hidden: bool, outputs: dict[str, Path | None],
          rtf: float | None, domain: int | None) -> None:
     from autograder.grading import grade
-    from autograder.render.jsonfile import to_json
     from autograder.render.terminal import test_line, to_terminal
     from autograder.results import TestResult, exact
     from autograder.submission import SubmissionNotFound, locate
@@ -150,15 +149,38 @@ def _run(exercise: str, submission: Path, hidden: bool, results: Path | None,
     result = grade(found, submission, hidden=hidden, domain=domain, real_time_factor=rtf,
                    progress=progress)
     click.echo(to_terminal(result, color=color))
-    if results is not None:
-        results.write_text(to_json(result), encoding="utf-8")
+    write_outputs(result, outputs, found.folder)
     if result.grader_error:
         raise GraderFault(result.grader_error)
 
 
+def write_outputs(result, outputs: dict[str, Path | None], folder: Path) -> None:  # noqa: ANN001
+    """Write each requested format of ``result`` (``--results``, ``--html``, ...)."""
+    from autograder.render.gradescope import to_gradescope
+    from autograder.render.html import to_html
+    from autograder.render.jsonfile import to_json
+    from autograder.render.junit import to_junit
+
+    renderers = {"results": to_json, "gradescope": to_gradescope, "junit": to_junit,
+                 "html": lambda r: to_html(r, folder)}
+    for name, path in outputs.items():
+        if path is not None:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_text(renderers[name](result), encoding="utf-8")
+
+
+def _formats(func):  # noqa: ANN001, ANN202
+    """``--results``, ``--gradescope``, ``--junit`` and ``--html`` FILE options."""
+    for name, text in (("html", "Write a self-contained HTML report to this file."),
+                       ("junit", "Write JUnit XML to this file."),
+                       ("gradescope", "Write Gradescope's results.json to this file."),
+                       ("results", "Write the results as JSON to this file.")):
+        func = click.option(f"--{name}", type=click.Path(path_type=Path, dir_okay=False),
+                            help=text)(func)
+    return func
+
+
 _submission = click.argument("submission", type=click.Path(path_type=Path))
-_results = click.option("--results", type=click.Path(path_type=Path, dir_okay=False),
-                        help="Write the results as JSON to this file.")
 _rtf = click.option("--real-time-factor", "rtf", type=float, default=None,
                     help="Override the exercise's simulation pace.")
 _domain = click.option("--domain", type=click.IntRange(0, 232), default=None,
@@ -168,28 +190,28 @@ _domain = click.option("--domain", type=click.IntRange(0, 232), default=None,
 @main.command()
 @click.argument("exercise")
 @_submission
-@_results
+@_formats
 @_rtf
 @_domain
 @_lang_option
-def check(exercise: str, submission: Path, results: Path | None, rtf: float | None,
-          domain: int | None) -> None:
+def check(exercise: str, submission: Path, rtf: float | None, domain: int | None,
+          **outputs: Path | None) -> None:
     """Run the public tests of EXERCISE on SUBMISSION (for students)."""
-    _run(exercise, submission, False, results, rtf, domain)
+    _run(exercise, submission, False, outputs, rtf, domain)
 
 
 @main.command("grade")
 @click.argument("exercise")
 @_submission
-@_results
+@_formats
 @_rtf
 @_domain
 @_lang_option
-def grade_command(exercise: str, submission: Path, results: Path | None, rtf: float | None,
-                  domain: int | None) -> None:
+def grade_command(exercise: str, submission: Path, rtf: float | None, domain: int | None,
+                  **outputs: Path | None) -> None:
     """Run the public and hidden tests of EXERCISE on SUBMISSION (the student's .py file or a
     folder holding it)."""
-    _run(exercise, submission, True, results, rtf, domain)
+    _run(exercise, submission, True, outputs, rtf, domain)
 
 
 main.add_command(sim_cli, "sim")

@@ -146,7 +146,8 @@ def _result(exercise: Exercise, report: dict[str, Any], returncode: int | None,
             name=raw["name"], label=raw["label"],
             score=_score(status, max_score, raw.get("fraction")), max_score=max_score,
             status=status, message=message, hint=raw.get("hint", ""),
-            visibility=raw["visibility"], details=raw.get("details", "")))
+            visibility=raw["visibility"], reveal=raw.get("reveal", "message"),
+            details=raw.get("details", ""), data={"charts": raw.get("charts", [])}))
     grader_error = None
     details = ""
     if errors:

@@ -13,6 +13,7 @@ Points and visibility travel through markers::
 
 from __future__ import annotations
 
+import itertools
 import json
 import os
 import tempfile
@@ -29,6 +30,7 @@ from autograder.i18n import _, set_language
 
 reporter_key = pytest.StashKey["GradingReporter"]()
 credit_key = pytest.StashKey["Credit"]()
+evidence_key = pytest.StashKey["Evidence"]()
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:
@@ -51,10 +53,14 @@ def pytest_configure(config: pytest.Config) -> None:
         "markers", "visibility(v): 'visible', 'hidden' or 'after_published' (default: "
         "hidden for tests under a hidden/ folder)")
     config.addinivalue_line("markers", "world(name): the world this module's tests run in")
+    config.addinivalue_line(
+        "markers", "reveal(what): what a student sees of a failure: 'message' or 'status' "
+        "(default: 'message' for visible tests, 'status' for hidden ones)")
     if config.getoption("exercise", None):
         if os.environ.get("AUTOGRADER_LANG"):
             set_language(os.environ["AUTOGRADER_LANG"])
-        reporter = GradingReporter(config.getoption("autograder_report"))
+        reporter = GradingReporter(config.getoption("autograder_report"),
+                                   config.getoption("exercise"))
         config.stash[reporter_key] = reporter
         config.pluginmanager.register(reporter, "autograder-reporter")
 
@@ -73,6 +79,14 @@ def _label(item: pytest.Item) -> str:
     return _(doc.strip().splitlines()[0].strip())
 
 
+def _reveal(item: pytest.Item, visibility: str) -> str:
+    """What a student sees of a test: 'message' (all) or 'status' (label and pass/fail)."""
+    marker = item.get_closest_marker("reveal")
+    if marker and marker.args:
+        return str(marker.args[0])
+    return "message" if visibility == "visible" else "status"
+
+
 def _visibility(item: pytest.Item, hidden_default: str) -> str:
     marker = item.get_closest_marker("visibility")
     if marker and marker.args:
@@ -83,8 +97,9 @@ def _visibility(item: pytest.Item, hidden_default: str) -> str:
 class GradingReporter:
     """Collects each test's outcome, points and message; writes the raw report as it goes."""
 
-    def __init__(self, path: str | None) -> None:
+    def __init__(self, path: str | None, exercise: str | None = None) -> None:
         self.path = Path(path) if path else None
+        self.exercise = exercise
         self.tests: dict[str, dict[str, Any]] = {}
         self.data: dict[str, Any] = {"logs": {}, "recordings": {}, "processes": []}
         self.hidden_default = "after_published"
@@ -104,15 +119,21 @@ class GradingReporter:
 
     @pytest.hookimpl(trylast=True)
     def pytest_collection_modifyitems(self, items: list[pytest.Item]) -> None:
+        if self.exercise:
+            from autograder.exercise import find_exercise
+
+            self.hidden_default = find_exercise(self.exercise).hidden_visibility
         for item in items:
             marker = item.get_closest_marker("points")
+            visibility = _visibility(item, self.hidden_default)
             self.tests[item.nodeid] = {
                 "nodeid": item.nodeid,
                 "done": False,
                 "name": item.name,
                 "label": _label(item),
                 "max_score": marker.args[0] if marker and marker.args else 1,
-                "visibility": _visibility(item, self.hidden_default),
+                "visibility": visibility,
+                "reveal": _reveal(item, visibility),
                 "status": "error",
                 "message": _("Not run: the grading run ended before this test."),
                 "hint": "",
@@ -128,6 +149,9 @@ class GradingReporter:
         entry = self.tests.get(item.nodeid)
         if entry is None:
             return
+        shown = item.stash.get(evidence_key, None)
+        if shown is not None and call.when == "call":
+            entry["charts"] = shown.charts
         if call.when == "setup" or call.when == "call":
             given = item.stash.get(credit_key, None)
             if report.passed and call.when == "call" and given and given.fraction is not None \
@@ -192,6 +216,27 @@ class Credit:
         self.message, self.hint = message, hint
 
 
+class Evidence:
+    """Data a test attaches for the report's pictures (e.g. message intervals)."""
+
+    def __init__(self) -> None:
+        self.charts: list[dict[str, Any]] = []
+
+    def intervals(self, title: str, times: list[float], limit: float | None = None) -> None:
+        """Plot the gaps between messages over simulation time (``limit``: the allowed gap)."""
+        points = [(round(b, 3), round(b - a, 4)) for a, b in itertools.pairwise(times)]
+        self.charts.append({"kind": "intervals", "title": title, "points": points,
+                            "limit": limit})
+
+
+@pytest.fixture
+def evidence(request: pytest.FixtureRequest) -> Evidence:
+    """Attach data to this test's entry in the report (see :class:`Evidence`)."""
+    given = Evidence()
+    request.node.stash[evidence_key] = given
+    return given
+
+
 @pytest.fixture
 def credit(request: pytest.FixtureRequest) -> Credit:
     """Give this test partial credit (see :class:`Credit`)."""
@@ -208,11 +253,7 @@ def exercise(pytestconfig: pytest.Config) -> Any:
     name = pytestconfig.getoption("exercise")
     if not name:
         pytest.skip("run with --exercise to use the autograder fixtures")
-    found = find_exercise(name)
-    reporter = pytestconfig.stash.get(reporter_key, None)
-    if reporter is not None:
-        reporter.hidden_default = found.hidden_visibility
-    return found
+    return find_exercise(name)
 
 
 @pytest.fixture(scope="session")

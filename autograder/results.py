@@ -14,6 +14,8 @@ from typing import Any, Literal
 Status = Literal["passed", "failed", "error", "skipped"]
 Visibility = Literal["visible", "hidden", "after_published"]
 Kind = Literal["exercise", "quiz"]
+# What a student is shown of a test: its label and pass/fail only, or also the message.
+Reveal = Literal["status", "message"]
 
 DEFAULT_PASS_MARK = Fraction(7, 10)
 
@@ -40,6 +42,8 @@ def number(value: Fraction) -> int | float:
 class TestResult:
     """The outcome of one test (or one quiz question)."""
 
+    __test__ = False  # not a pytest test class, despite its name
+
     name: str
     label: str
     score: Fraction
@@ -48,12 +52,22 @@ class TestResult:
     message: str = ""
     hint: str = ""
     visibility: Visibility = "visible"
+    reveal: Reveal = "message"
     details: str = ""
     data: dict[str, Any] = dataclasses.field(default_factory=dict)
 
     @property
     def passed(self) -> bool:
         return self.status == "passed"
+
+    @property
+    def student_message(self) -> str:
+        """The message as a student may see it (hidden tests may reveal only pass/fail)."""
+        return self.message if self.reveal == "message" else ""
+
+    @property
+    def student_hint(self) -> str:
+        return self.hint if self.reveal == "message" else ""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -112,6 +126,7 @@ class RunResult:
                     "message": t.message,
                     "hint": t.hint,
                     "visibility": t.visibility,
+                    "reveal": t.reveal,
                 }
                 for t in self.tests
             ],

@@ -85,6 +85,11 @@ def _environment() -> jinja2.Environment:
 _ENV = _environment()
 
 
+def environment() -> jinja2.Environment:
+    """The autoescaped template environment shared by quiz pages and grading reports."""
+    return _ENV
+
+
 def _page_context(quiz: Quiz, lang: str) -> dict[str, Any]:
     loc = Localizer(quiz, lang)
     return {

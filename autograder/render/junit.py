@@ -1,0 +1,47 @@
+"""JUnit XML, which every CI system reads: one testcase per test, failures with messages."""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+
+from autograder.results import RunResult, number
+
+
+def to_junit(result: RunResult) -> str:
+    failures = sum(t.status == "failed" for t in result.tests)
+    errors = sum(t.status == "error" for t in result.tests)
+    skipped = sum(t.status == "skipped" for t in result.tests)
+    suites = ET.Element("testsuites")
+    suite = ET.SubElement(suites, "testsuite", {
+        "name": f"{result.kind}.{result.id}", "tests": str(len(result.tests)),
+        "failures": str(failures), "errors": str(errors), "skipped": str(skipped),
+        "time": f"{result.execution_time:.3f}",
+    })
+    properties = ET.SubElement(suite, "properties")
+    for name, value in (("score", number(result.score)), ("max_score", number(result.max_score)),
+                        ("passed", str(result.passed).lower()),
+                        ("pass_mark", number(result.pass_mark)), ("lang", result.lang)):
+        ET.SubElement(properties, "property", {"name": name, "value": str(value)})
+    for test in result.tests:
+        case = ET.SubElement(suite, "testcase", {
+            "classname": f"{result.id}.{test.visibility}", "name": test.name,
+            "time": "0"})
+        ET.SubElement(case, "properties").extend([
+            ET.Element("property", {"name": "label", "value": test.label}),
+            ET.Element("property", {"name": "score", "value": str(number(test.score))}),
+            ET.Element("property", {"name": "max_score", "value": str(number(test.max_score))}),
+        ])
+        text = "\n".join(p for p in (test.message, test.hint) if p)
+        if test.status == "failed":
+            ET.SubElement(case, "failure", {"message": test.message.splitlines()[0]
+                                            if test.message else ""}).text = text
+        elif test.status == "error":
+            ET.SubElement(case, "error", {"message": test.message}).text = test.details or text
+        elif test.status == "skipped":
+            ET.SubElement(case, "skipped", {"message": test.message})
+    if result.grader_error:
+        ET.SubElement(suite, "system-err").text = result.grader_details
+    if result.log_tail:
+        ET.SubElement(suite, "system-out").text = result.log_tail
+    ET.indent(suites)
+    return ET.tostring(suites, encoding="unicode", xml_declaration=True) + "\n"

@@ -1,0 +1,128 @@
+"""The renderers are pure functions of a RunResult: each checked against its format."""
+
+from __future__ import annotations
+
+import json
+import xml.etree.ElementTree as ET
+from fractions import Fraction
+
+import pytest
+
+from autograder.i18n import set_language
+from autograder.render.gradescope import to_gradescope, to_gradescope_dict
+from autograder.render.html import to_html
+from autograder.render.jsonfile import to_json
+from autograder.render.junit import to_junit
+from autograder.render.terminal import to_terminal
+from autograder.results import RunResult, TestResult
+
+SECRET = "internal detail of a hidden test"
+
+
+def result(lang: str = "en", grader_error: str | None = None) -> RunResult:
+    tests = (
+        TestResult("test_starts", "The node starts", Fraction(1), Fraction(1), "passed"),
+        TestResult("test_rate", "cmd_vel keeps 10 Hz", Fraction(0), Fraction(2), "failed",
+                   message="`cmd_vel` came at 3.1 Hz <script>alert(1)</script>",
+                   hint="Is the planner in its own callback group?",
+                   data={"charts": [{"kind": "intervals", "title": "cmd_vel",
+                                     "points": [[0.1, 0.1], [0.2, 0.1], [0.9, 0.7]],
+                                     "limit": 0.15}]}),
+        TestResult("test_hidden", "Refuses bad values", Fraction(0), Fraction(2), "failed",
+                   message=SECRET, hint=SECRET, visibility="after_published",
+                   reveal="status"),
+        TestResult("test_hidden2", "Exits on a bad override", Fraction(1), Fraction(1),
+                   "passed", visibility="hidden", reveal="status"),
+        TestResult("test_partial", "Reaches the goal", Fraction(1, 2), Fraction(1), "failed",
+                   message="covered half the way"),
+    )
+    return RunResult("exercise", "timer_sync", "A multi-rate controller", tests, lang=lang,
+                     grader_error=grader_error, execution_time=12.5, log_tail="[INFO] hi")
+
+
+@pytest.fixture(autouse=True)
+def english():
+    set_language("en")
+    yield
+    set_language("en")
+
+
+def test_json_has_the_results_shape():
+    data = json.loads(to_json(result()))
+    assert data["exercise"] == "timer_sync"
+    assert (data["score"], data["max_score"], data["passed"]) == (2.5, 7, False)
+    assert [t["status"] for t in data["tests"]] == ["passed", "failed", "failed", "passed",
+                                                     "failed"]
+    assert {"name", "score", "max_score", "status", "message", "visibility"} <= set(
+        data["tests"][0])
+
+
+def test_gradescope_fields_and_visibility_values():
+    data = to_gradescope_dict(result())
+    assert json.loads(to_gradescope(result())) == data
+    assert data["score"] == 2.5 and data["execution_time"] == 12
+    assert data["stdout_visibility"] in {"hidden", "visible", "after_due_date",
+                                         "after_published"}
+    assert isinstance(data["output"], str)
+    for test in data["tests"]:
+        assert {"name", "score", "max_score", "status", "output", "visibility"} <= set(test)
+        assert test["status"] in {"passed", "failed"}
+        assert test["visibility"] in {"visible", "hidden", "after_due_date", "after_published"}
+    assert [t["visibility"] for t in data["tests"]] == [
+        "visible", "visible", "after_published", "hidden", "visible"]
+    assert sum(t["score"] for t in data["tests"]) == data["score"]
+
+
+def test_gradescope_hides_what_a_hidden_test_does_not_reveal():
+    text = to_gradescope(result())
+    assert SECRET not in text
+    assert "Is the planner in its own callback group?" in text
+
+
+def test_junit_parses_back():
+    root = ET.fromstring(to_junit(result()).encode())
+    suite = root.find("testsuite")
+    assert suite is not None
+    assert (suite.get("tests"), suite.get("failures"), suite.get("errors")) == ("5", "3", "0")
+    cases = suite.findall("testcase")
+    assert [c.get("name") for c in cases] == ["test_starts", "test_rate", "test_hidden",
+                                               "test_hidden2", "test_partial"]
+    failure = cases[1].find("failure")
+    assert failure is not None and "3.1 Hz" in failure.get("message")
+    props = {p.get("name"): p.get("value") for p in suite.find("properties")}
+    assert props["score"] == "2.5" and props["passed"] == "false"
+
+
+def test_junit_reports_a_grader_error():
+    root = ET.fromstring(to_junit(result(grader_error="boom")).encode())
+    assert root.find("testsuite/system-err") is not None
+
+
+def test_terminal_has_a_line_per_test_and_the_verdict():
+    text = to_terminal(result())
+    for label in ("The node starts", "cmd_vel keeps 10 Hz", "Refuses bad values"):
+        assert label in text
+    assert "Score: 2.5/7" in text and "not passed" in text
+
+
+def test_terminal_says_when_the_grader_failed():
+    assert "The autograder failed, tell your instructor." in to_terminal(result(grader_error="x"))
+
+
+def test_html_report_escapes_hides_and_draws():
+    page = to_html(result())
+    assert '<html lang="en" dir="ltr">' in page
+    assert "<script>alert(1)</script>" not in page and "&lt;script&gt;" in page
+    assert SECRET not in page
+    assert '<code dir="ltr">cmd_vel</code>' in page
+    assert 'class="chart"' in page and 'class="limit"' in page
+    assert "[INFO] hi" in page
+
+
+def test_urdu_html_report_is_right_to_left():
+    set_language("ur")
+    page = to_html(result(lang="ur"))
+    assert '<html lang="ur" dir="rtl">' in page
+    assert "Noto Nastaliq Urdu" in page
+    assert '<code dir="ltr">cmd_vel</code>' in page
+    assert '<pre dir="ltr">' in page
