@@ -15,7 +15,7 @@ import click
 
 from autograder import __version__
 from autograder.declarative import ContentError
-from autograder.i18n import LANGUAGES, _, set_language
+from autograder.i18n import LANGUAGES, _, get_language, set_language
 from autograder.i18n_cli import i18n_cli
 from autograder.quiz.cli import quiz_cli
 from sim.cli import sim_cli
@@ -214,6 +214,130 @@ def grade_command(exercise: str, submission: Path, rtf: float | None, domain: in
     _run(exercise, submission, True, outputs, rtf, domain)
 
 
+@main.command()
+@click.argument("out", type=click.Path(path_type=Path, file_okay=False))
+def release(out: Path) -> None:
+    """Build what students get in OUT: starter code, READMEs, public tests and the tools to
+    run them, quizzes as pages; no hidden tests, no solutions, no quiz keys."""
+    from autograder.release import build_release
+
+    if out.exists():
+        raise UsageProblem(_("{path} already exists").format(path=out))
+    try:
+        build_release(out)
+    except ContentError as exc:
+        raise UsageProblem(str(exc)) from None
+    click.echo(_("release written to {path}").format(path=out))
+
+
+@main.group()
+def bundle() -> None:
+    """Package an exercise's autograder for a grading service."""
+
+
+@bundle.command("gradescope")
+@click.argument("exercise")
+@click.argument("zip_path", metavar="OUT.zip", type=click.Path(path_type=Path, dir_okay=False))
+def bundle_gradescope(exercise: str, zip_path: Path) -> None:
+    """A Gradescope autograder zip (setup.sh, run_autograder) for EXERCISE."""
+    from autograder.release import build_gradescope_bundle
+
+    build_gradescope_bundle(_exercise(exercise), zip_path)
+    click.echo(_("Gradescope autograder written to {path}").format(path=zip_path))
+
+
+@main.command("grade-batch")
+@click.argument("item", metavar="EXERCISE_OR_QUIZ")
+@click.argument("submissions", type=click.Path(path_type=Path, file_okay=False, exists=True))
+@click.option("--jobs", type=click.IntRange(1, 64), default=1, show_default=True,
+              help="Gradings run at the same time (each on its own ROS domain).")
+@click.option("--csv", "csv_path", type=click.Path(path_type=Path, dir_okay=False),
+              required=True, help="The gradebook CSV (merged into if it exists).")
+@click.option("--out", type=click.Path(path_type=Path, file_okay=False), default=None,
+              help="Folder of each student's reports (default: grades/EXERCISE).")
+@click.option("--shard", default=None, metavar="I/N",
+              help="Grade only share I of N (stable: by a hash of the student's name).")
+@_lang_option
+def grade_batch(item: str, submissions: Path, jobs: int, csv_path: Path, out: Path | None,
+                shard: str | None) -> None:
+    """Grade every submission in SUBMISSIONS (one sub-folder or file per student), or score
+    every answers file for a quiz. Resumable: graded students are skipped."""
+    from autograder.batch import parse_shard, run_batch, students
+
+    try:
+        share = parse_shard(shard) if shard else None
+    except ValueError:
+        raise UsageProblem(_("--shard must be I/N with 1 <= I <= N, got {value}").format(
+            value=shard)) from None
+    out = out or Path("grades") / item
+    grade_one, suffix, extra = _batch_item(item)
+
+    def progress(student: str, result) -> None:  # noqa: ANN001
+        if result is None:
+            click.echo(_("{student}: already graded").format(student=student), err=True)
+        else:
+            click.echo(f"{student}: {result.score}/{result.max_score}", err=True)
+
+    rows = run_batch(students(submissions, suffix), grade_one, out, csv_path, jobs=jobs,
+                     shard=share, extra=extra, progress=progress)
+    click.echo(_("{count} rows in {path}").format(count=len(rows), path=csv_path))
+
+
+def _batch_item(item: str):  # noqa: ANN202
+    """How to grade one student's entry for an exercise or a quiz."""
+    from autograder.grading import grade
+    from autograder.quiz.catalog import find_quiz
+    from autograder.quiz.scoring import AnswersError, read_answers, score
+
+    try:
+        exercise = _exercise(item)
+    except UsageProblem:
+        exercise = None
+    if exercise is not None:
+        def extra(result, folder: Path) -> None:  # noqa: ANN001
+            write_outputs(result, {"html": folder / "report.html",
+                                   "gradescope": folder / "gradescope.json"}, exercise.folder)
+
+        return (lambda path: grade(exercise, path)), None, extra
+    try:
+        quiz = find_quiz(item).quiz
+    except ContentError as exc:
+        raise UsageProblem(str(exc)) from None
+
+    def score_one(path: Path):  # noqa: ANN202
+        try:
+            return score(quiz, read_answers(path, quiz), get_language())
+        except AnswersError:
+            return score(quiz, {}, get_language())  # an unreadable answers file scores 0
+
+    return score_one, ".json", None
+
+
+@main.group("gradebook")
+def gradebook_group() -> None:
+    """Work with gradebook CSV files."""
+
+
+@gradebook_group.command("merge")
+@click.argument("out", type=click.Path(path_type=Path, dir_okay=False))
+@click.argument("inputs", nargs=-1, required=True,
+                type=click.Path(path_type=Path, dir_okay=False, exists=True))
+def gradebook_merge(out: Path, inputs: tuple[Path, ...]) -> None:
+    """Merge gradebooks (e.g. from shards) into OUT; a later file wins a duplicate row."""
+    from autograder import gradebook
+
+    try:
+        rows = gradebook.merge(*(gradebook.read(p) for p in inputs))
+    except ContentError as exc:
+        raise UsageProblem(str(exc)) from None
+    gradebook.write(out, rows)
+    click.echo(_("{count} rows in {path}").format(count=len(rows), path=out))
+
+
 main.add_command(sim_cli, "sim")
 main.add_command(quiz_cli, "quiz")
 main.add_command(i18n_cli, "i18n")
+
+
+if __name__ == "__main__":
+    main()

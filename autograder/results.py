@@ -104,6 +104,22 @@ class RunResult:
         return self.grader_error is None and self.max_score > 0 and \
             self.fraction >= self.pass_mark
 
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> RunResult:
+        """Read back what :meth:`to_dict` wrote (a batch resuming from its reports)."""
+        kind: Kind = "exercise" if "exercise" in data else "quiz"
+        tests = tuple(
+            TestResult(name=t["name"], label=t.get("label", t["name"]),
+                       score=exact(t["score"]), max_score=exact(t["max_score"]),
+                       status=t["status"], message=t.get("message", ""),
+                       hint=t.get("hint", ""), visibility=t.get("visibility", "visible"),
+                       reveal=t.get("reveal", "message"))
+            for t in data["tests"])
+        return cls(kind=kind, id=data[kind], title=data.get("title", ""), tests=tests,
+                   pass_mark=exact(data.get("pass_mark", "0.7")), lang=data.get("lang", "en"),
+                   grader_error=data.get("grader_error"),
+                   execution_time=data.get("execution_time", 0.0))
+
     def to_dict(self) -> dict[str, Any]:
         """Our JSON results shape (``--results``)."""
         return {

@@ -1,0 +1,129 @@
+"""What students get, and what Gradescope runs.
+
+``build_release``: the platform, each exercise's README, starter and public tests, and
+the quizzes rendered as pages (their YAML holds the key) — nothing of the hidden tests or
+the reference solutions.  ``build_gradescope_bundle``: a Gradescope autograder zip
+(``setup.sh``, ``run_autograder``) holding the platform and one exercise, hidden tests
+included, that grades ``/autograder/submission`` into ``/autograder/results/results.json``.
+"""
+
+from __future__ import annotations
+
+import shutil
+import stat
+import zipfile
+from pathlib import Path
+
+from autograder.course import course_root
+from autograder.exercise import Exercise, list_exercises
+
+# The platform itself: what `pip install .` needs and what runs the tests.
+PLATFORM = ("pyproject.toml", "README.md", "tasks.py", "Makefile", "babel.cfg", "autograder",
+            "sim", "locales")
+_IGNORE = shutil.ignore_patterns("__pycache__", "*.pyc", "*.mo", ".*")
+
+
+def _copy(source: Path, dest: Path) -> None:
+    if source.is_dir():
+        shutil.copytree(source, dest, ignore=_IGNORE, dirs_exist_ok=True)
+    elif source.exists():
+        dest.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(source, dest)
+
+
+def _copy_platform(root: Path, out: Path) -> None:
+    for name in PLATFORM:
+        _copy(root / name, out / name)
+
+
+def student_files(exercise: Exercise) -> list[Path]:
+    """An exercise's files a student may have: everything but solution/ and tests/hidden/."""
+    hidden = {exercise.folder / "solution", exercise.hidden_tests}
+    files = []
+    for path in sorted(exercise.folder.rglob("*")):
+        if not path.is_file() or "__pycache__" in path.parts:
+            continue
+        if any(path.is_relative_to(h) for h in hidden):
+            continue
+        files.append(path)
+    return files
+
+
+def build_release(out: Path, exercises: list[Exercise] | None = None) -> Path:
+    """Write the student release to ``out`` (which must not exist yet)."""
+    from autograder.quiz.catalog import load_all
+    from autograder.quiz.render import render_markdown, render_page
+
+    root = course_root()
+    out.mkdir(parents=True)
+    _copy_platform(root, out)
+    for exercise in exercises or list_exercises():
+        for path in student_files(exercise):
+            _copy(path, out / "assignments" / exercise.id / path.relative_to(exercise.folder))
+    pages = out / "quizzes-rendered"
+    for quiz_file in load_all():
+        quiz = quiz_file.quiz
+        for lang in quiz.languages:
+            pages.mkdir(parents=True, exist_ok=True)
+            (pages / f"{quiz.id}.{lang}.html").write_text(render_page(quiz, lang),
+                                                          encoding="utf-8")
+            (pages / f"{quiz.id}.{lang}.mdx").write_text(render_markdown(quiz, lang),
+                                                         encoding="utf-8")
+    return out
+
+
+SETUP_SH = """#!/usr/bin/env bash
+# Gradescope runs this once when it builds the autograder image (Ubuntu, as root).
+set -euo pipefail
+ROOT="${AUTOGRADER_ROOT:-/autograder}"
+if command -v apt-get >/dev/null && [ "$(id -u)" = 0 ]; then
+  apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq python3-venv
+fi
+python3 -m venv "$ROOT/venv"
+"$ROOT/venv/bin/pip" install -q --upgrade pip
+"$ROOT/venv/bin/pip" install -q "$ROOT/source"
+"""
+
+RUN_AUTOGRADER = """#!/usr/bin/env bash
+# Gradescope runs this for every submission; results go to results/results.json.
+set -uo pipefail
+ROOT="${{AUTOGRADER_ROOT:-/autograder}}"
+VENV="${{AUTOGRADER_VENV:-$ROOT/venv}}"
+mkdir -p "$ROOT/results"
+cd "$ROOT/source"
+AUTOGRADER_COURSE="$ROOT/source" "$VENV/bin/autograder" grade {exercise} "$ROOT/submission" \\
+    --gradescope "$ROOT/results/results.json" --results "$ROOT/results/ours.json"
+status=$?
+if [ ! -s "$ROOT/results/results.json" ]; then
+  # The grader could not even start: say so rather than leave Gradescope without results.
+  message="The autograder failed (status $status), tell your instructor."
+  printf '{{"score": 0, "output": "%s", "tests": []}}\\n' "$message" \\
+    > "$ROOT/results/results.json"
+fi
+exit 0
+"""
+
+
+def build_gradescope_bundle(exercise: Exercise, zip_path: Path) -> Path:
+    """Write Gradescope's autograder zip for ``exercise``."""
+    root = course_root()
+    zip_path.parent.mkdir(parents=True, exist_ok=True)
+    with zipfile.ZipFile(zip_path, "w", zipfile.ZIP_DEFLATED) as bundle:
+        for name, text in (("setup.sh", SETUP_SH),
+                           ("run_autograder", RUN_AUTOGRADER.format(exercise=exercise.id))):
+            info = zipfile.ZipInfo(name)
+            info.external_attr = (stat.S_IFREG | 0o755) << 16
+            bundle.writestr(info, text)
+        for name in PLATFORM:
+            source = root / name
+            paths = [source] if source.is_file() else sorted(source.rglob("*"))
+            for path in paths:
+                if path.is_file() and "__pycache__" not in path.parts and path.suffix != ".mo":
+                    bundle.write(path, f"source/{path.relative_to(root)}")
+        solution = exercise.folder / "solution"  # not needed to grade: never on the image
+        for path in sorted(exercise.folder.rglob("*")):
+            if path.is_file() and "__pycache__" not in path.parts \
+                    and not path.is_relative_to(solution):
+                bundle.write(path, f"source/assignments/{exercise.id}/"
+                                   f"{path.relative_to(exercise.folder)}")
+    return zip_path
