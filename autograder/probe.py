@@ -127,11 +127,23 @@ class Probe:
         self.wait_for(lambda: self.now >= end, seconds + 1.0)
 
     # -- topics ------------------------------------------------------------------------
-    def subscribe(self, msg_type: type[M], topic: str, depth: int = 1000) -> Inbox[M]:
+    def subscribe(self, msg_type: type[M], topic: str, depth: int = 1000,
+                  stamp: str = "received") -> Inbox[M]:
+        """Record ``topic``; each message stamped with the sim time it arrived at, or with
+        ``stamp="published"`` the sim time it was sent at (from its DDS source timestamp,
+        so a probe slow to receive under load does not stamp it late)."""
         inbox: Inbox[M] = Inbox(topic)
         qos = QoSProfile(depth=depth, reliability=ReliabilityPolicy.RELIABLE)
-        inbox.subscription = self.node.create_subscription(
-            msg_type, topic, lambda m: inbox.add(self.now, m), qos)
+        sent_at = getattr(self.world, "sim_time_at", None)
+        if stamp == "published" and sent_at is not None:
+            def record(message: Any, info: dict[str, Any]) -> None:
+                source = info.get("source_timestamp") if isinstance(info, dict) else None
+                inbox.add(min(sent_at(source), self.now) if source else self.now, message)
+
+            inbox.subscription = self.node.create_subscription(msg_type, topic, record, qos)
+        else:
+            inbox.subscription = self.node.create_subscription(
+                msg_type, topic, lambda m: inbox.add(self.now, m), qos)
         return inbox
 
     def publish(self, msg_type: type, topic: str, message: Any) -> None:

@@ -35,6 +35,7 @@ only touched under the bridge's lock, and waiters are woken by a Condition each 
 from __future__ import annotations
 
 import array
+import bisect
 import collections
 import math
 import threading
@@ -117,6 +118,8 @@ class SimBridge:
         self._pids: set[int] = set()
         self._cmd: tuple[float, float] | None = None
         self._window: collections.deque[tuple[float, float]] = collections.deque(maxlen=100)
+        # (time.time_ns() just before a tick's /clock went out, that tick's sim time)
+        self._clock_log: list[tuple[int, float]] = []
         self._threads: list[threading.Thread] = []
         self.node = Node(node_name, context=context)
         qos = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
@@ -225,6 +228,16 @@ class SimBridge:
             (w0, s0), (w1, s1) = self._window[0], self._window[-1]
         return (s1 - s0) / (w1 - w0) if w1 > w0 else 0.0
 
+    def sim_time_at(self, wall_ns: int) -> float:
+        """Sim time of the last /clock published at or before system time ``wall_ns``.
+
+        A message whose DDS source timestamp is ``wall_ns`` was sent while its publisher's
+        clock read at most this: a stamp that does not depend on how late we receive it.
+        """
+        log = self._clock_log
+        i = bisect.bisect_right(log, wall_ns, key=lambda entry: entry[0]) - 1
+        return log[i][1] if i >= 0 else 0.0
+
     def wait_until(self, sim_time: float, wall_timeout: float) -> bool:
         """Block until sim time reaches ``sim_time``; False if ``wall_timeout`` passes first."""
         with self._cond:
@@ -326,6 +339,7 @@ class SimBridge:
         sec, nanosec = _stamp(self.world.time)
         clock = Clock()
         clock.clock.sec, clock.clock.nanosec = sec, nanosec
+        self._clock_log.append((time.time_ns(), self.world.time))
         self._clock_pub.publish(clock)
         for out in outputs:
             if out.odom is not None:
