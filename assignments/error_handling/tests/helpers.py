@@ -1,0 +1,144 @@
+"""Shared steps of the error_handling tests: scans made to order, and what cmd_vel says."""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Callable
+from typing import Any
+
+from geometry_msgs.msg import Twist
+from sensor_msgs.msg import LaserScan
+
+from autograder.errors import StudentFailure
+from autograder.i18n import _
+
+# The simulated lidar: 360 beams counter-clockwise from straight ahead, 0.12 to 3.5 m.
+BEAMS = 360
+INCREMENT = 2 * math.pi / BEAMS
+RANGE_MIN, RANGE_MAX = 0.12, 3.5
+FORWARD, TURN = 0.2, 0.5
+# A command published at a tick can be stamped by the probe one tick (0.1 s) late.
+LATE = 0.15
+
+
+def bearing(beam: int) -> float:
+    """The beam's direction in degrees, -180..180, positive to the left."""
+    return (beam + 180) % 360 - 180
+
+
+def make_scan(reading: Callable[[float], float] | float = 2.0, *, count: int = BEAMS,
+              angle_increment: float = INCREMENT, angle_max: float | None = None) -> LaserScan:
+    """A scan shaped like the world's; ``reading(bearing_degrees)`` gives each range."""
+    scan = LaserScan()
+    scan.header.frame_id = "base_scan"
+    scan.angle_min = 0.0
+    scan.angle_increment = angle_increment
+    scan.angle_max = (BEAMS - 1) * INCREMENT if angle_max is None else angle_max
+    scan.scan_time = 0.1
+    scan.range_min, scan.range_max = RANGE_MIN, RANGE_MAX
+    value = reading if callable(reading) else (lambda _b: float(reading))
+    scan.ranges = [float(value(bearing(i % BEAMS))) for i in range(count)]
+    return scan
+
+
+def blocked(toward: int) -> LaserScan:
+    """An obstacle 0.4 m ahead; open on the side ``toward`` (+1 left, -1 right), near on the
+    other, so every sensible measure of room agrees."""
+    def reading(b: float) -> float:
+        if abs(b) <= 35:
+            return 0.4
+        return 3.0 if b * toward > 0 else 0.5
+    return make_scan(reading)
+
+
+CLEAR = make_scan(2.0)
+
+
+class ScanFeeder:
+    """Publishes one scan on /scan every 0.1 s of simulation time, like the lidar would."""
+
+    def __init__(self, probe: Any) -> None:
+        self.probe = probe
+        self.scan: LaserScan | None = None
+        probe.publish(LaserScan, "/scan", CLEAR)  # creates the publisher; nobody listens yet
+        self.timer = probe.node.create_timer(0.1, self._tick)
+
+    def _tick(self) -> None:
+        scan = self.scan
+        if scan is not None:
+            scan.header.stamp = self.probe.node.get_clock().now().to_msg()
+            self.probe.publish(LaserScan, "/scan", scan)
+
+    def feed(self, scan: LaserScan | None) -> float:
+        """From now on publish ``scan`` (None: nothing); the simulation time it changed."""
+        self.scan = scan
+        return self.probe.now
+
+
+def is_zero(t: Twist) -> bool:
+    return all(v == 0.0 for v in (t.linear.x, t.linear.y, t.linear.z,
+                                  t.angular.x, t.angular.y, t.angular.z))
+
+
+def is_forward(t: Twist) -> bool:
+    return abs(t.linear.x - FORWARD) < 1e-3 and abs(t.angular.z) < 1e-3
+
+
+def turn_of(t: Twist) -> int:
+    """+1 turning left in place at TURN, -1 right, 0 otherwise."""
+    if abs(t.linear.x) > 1e-3 or abs(abs(t.angular.z) - TURN) > 1e-3:
+        return 0
+    return 1 if t.angular.z > 0 else -1
+
+
+def describe(t: Twist) -> str:
+    return f"linear.x={t.linear.x:.3g}, angular.z={t.angular.z:.3g}"
+
+
+def alive(node: Any, when: str) -> None:
+    """Fail with the node's last words if its process has ended."""
+    if node.running():
+        return
+    raise StudentFailure(
+        _("The node's process ended {when} (exit status {code}). Its last lines:\n{tail}")
+        .format(when=when, code=node.returncode, tail=node.output_tail(12)),
+        _("Catch exceptions inside your callbacks: log them with get_logger().error(...), "
+          "publish a stop and carry on."))
+
+
+def wait_command(probe: Any, inbox: Any, since: float, wanted: Callable[[Twist], bool],
+                 sim_timeout: float) -> Twist | None:
+    """The first cmd_vel stamped at or after ``since`` that is ``wanted``, or None."""
+    def found() -> Twist | None:
+        return next((m for t, m in inbox.items if t >= since and wanted(m)), None)
+    probe.wait_for(lambda: found() is not None, sim_timeout)
+    return found()
+
+
+def window(inbox: Any, start: float, end: float) -> list[Twist]:
+    return [m for t, m in inbox.items if start <= t <= end]
+
+
+def settle_forward(probe: Any, inbox: Any, feeder: ScanFeeder, node: Any) -> float:
+    """Feed a clear view until the node drives forward; the simulation time it did."""
+    since = feeder.feed(CLEAR)
+    if wait_command(probe, inbox, since, is_forward, 2.0) is None:
+        alive(node, _("while it was shown a clear way ahead"))
+        last = inbox.messages[-1:] or None
+        raise StudentFailure(
+            _("With nothing nearer than 2 m, cmd_vel never said linear.x={v}, angular.z=0 "
+              "within 2 s (last command: {last}).").format(
+                v=FORWARD, last=describe(last[0]) if last else _("none")),
+            _("Publish from a 10 Hz timer: forward at 0.2 m/s when the nearest valid reading "
+              "within ±30° of ahead is over 0.6 m."))
+    return probe.now
+
+
+WARN_LINE = re.compile(r"^\[WARN\] \[(\d+(?:\.\d+)?)\]", re.MULTILINE)
+
+
+def warnings_between(output: str, start_wall: float, end_wall: float) -> int:
+    """WARN lines logged (wall-clock stamps, as rclpy writes them) within the span."""
+    return sum(1 for m in WARN_LINE.finditer(output)
+               if start_wall <= float(m.group(1)) <= end_wall)

@@ -1,0 +1,196 @@
+"""Hidden tests: 60 s of simulation time among obstacles, with the lidar misbehaving.
+
+The faults are injected relative to the moment the node first drives, between scans (a
+fault span starts and ends 0.05 s after a scan), so the same scans are affected in
+every run.  Speeds are the world's own measurements (odometry, recorded at 50 Hz).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from typing import Any
+
+import pytest
+from helpers import LATE, describe, is_zero, warnings_between, window
+
+from autograder.errors import StudentFailure
+from autograder.i18n import _
+from sim.worldfile import Fault
+
+pytestmark = pytest.mark.world("obstacles")
+
+RUN = 60.0
+# Faults, with start and end counted from the start of the run.
+SCHEDULE = (
+    Fault(kind="nan", start=4.0, end=7.0, fraction=0.3),
+    Fault(kind="empty", start=9.0, end=9.5),
+    Fault(kind="dropout", start=12.0, end=16.0),
+    Fault(kind="wrong_length", start=19.0, end=19.5, length=180),
+    Fault(kind="inf", start=22.0, end=25.0, fraction=0.2),
+    Fault(kind="neg_inf", start=22.0, end=25.0, fraction=0.1),
+    Fault(kind="below_min", start=27.0, end=30.0, fraction=0.1),
+    Fault(kind="above_max", start=27.0, end=30.0, fraction=0.1),
+    Fault(kind="nan", start=32.0, end=33.0, fraction=0.5),
+    Fault(kind="dropout", start=36.0, end=39.0),
+    Fault(kind="empty", start=42.0, end=42.3),
+    Fault(kind="wrong_length", start=45.0, end=45.5, length=400),
+    Fault(kind="nan", start=48.0, end=52.0, fraction=0.2),
+    Fault(kind="dropout", start=54.0, end=56.0),
+)
+# Stopped within the 0.5 s watchdog, one control cycle, braking (< 0.1 s at the world's
+# 2.5 m/s^2 and 6 rad/s^2) and a tick of message delay.
+STOP_WITHIN = 0.5 + 0.1 + 0.1 + LATE
+STILL_LINEAR, STILL_ANGULAR = 0.01, 0.02
+MOVE_WITHIN = 1.0
+
+
+@dataclasses.dataclass
+class Dropout:
+    start: float
+    end: float
+    wall_start: float = 0.0
+    wall_end: float = 0.0
+
+
+@dataclasses.dataclass
+class Run:
+    """What happened in the run, for the tests to judge."""
+
+    start: float
+    end: float
+    dropouts: list[Dropout]
+    died_at: float | None
+    commands: Any
+    output: str
+
+
+@pytest.fixture(scope="module")
+def run(world, probe, student, commands) -> Run:
+    """Drive through the faults for RUN seconds of simulation time (or until the node dies)."""
+    if not probe.wait_for(lambda: any(not is_zero(m) for m in commands.messages), 5.0):
+        raise StudentFailure(
+            _("In the world with obstacles the node never published a moving command on "
+              "cmd_vel within 5 s."),
+            _("Publish forward or turning commands from a 10 Hz timer."))
+    t0 = math.floor(probe.now * 10 + 1e-6) / 10 + 0.05
+    for fault in SCHEDULE:
+        world.inject(dataclasses.replace(fault, start=t0 + fault.start, end=t0 + fault.end))
+    dropouts = [Dropout(t0 + f.start, t0 + f.end) for f in SCHEDULE if f.kind == "dropout"]
+    marks = sorted([(d.start, d, "wall_start") for d in dropouts] +
+                   [(d.end, d, "wall_end") for d in dropouts], key=lambda m: m[0])
+    died_at = None
+    for when, dropout, field in [*marks, (t0 + RUN, None, "")]:
+        probe.wait_for(lambda w=when: probe.now >= w or not student.running(), when - probe.now)
+        if not student.running():
+            died_at = probe.now
+            break
+        if dropout is not None:
+            setattr(dropout, field, time.time())
+    probe.wait_sim(0.3)  # let the last messages arrive
+    return Run(t0, t0 + RUN, dropouts, died_at, commands, student.output())
+
+
+def _died(run: Run, student) -> None:
+    if run.died_at is not None:
+        raise StudentFailure(
+            _("The node's process ended {seconds:.1f} s into the run (exit status {code}), "
+              "so the rest could not be judged. Its last lines:\n{tail}").format(
+                seconds=run.died_at - run.start, code=student.returncode,
+                tail=student.output_tail(12)),
+            _("Catch exceptions in your callbacks and ignore invalid readings; the public "
+              "tests show which scans hurt."))
+
+
+@pytest.mark.points(2)
+def test_stays_alive(run, student):
+    """Through 60 s of faulty scans the node stays alive and keeps publishing"""
+    _died(run, student)
+    recent = window(run.commands, run.end - 0.5, run.end + 0.3)
+    if not recent:
+        raise StudentFailure(
+            _("The node was running at the end of the run but had not published on cmd_vel "
+              "for the last 0.5 s of simulation time."),
+            _("Keep the 10 Hz timer publishing, whatever the scans look like."))
+
+
+@pytest.mark.points(2)
+def test_never_collides(run, world, student):
+    """The robot never touches an obstacle or a wall"""
+    _died(run, student)
+    _, collisions = world.recording.snapshot()
+    if collisions:
+        first = collisions[0]
+        raise StudentFailure(
+            _("The robot hit {what} at ({x:.2f}, {y:.2f}), {seconds:.1f} s into the run.")
+            .format(what=first.what, x=first.x, y=first.y, seconds=first.t - run.start),
+            _("Stop going forward when the nearest valid reading within ±30° of ahead is "
+              "0.6 m or nearer; do not let invalid readings hide an obstacle."))
+
+
+@pytest.mark.points(2)
+def test_stops_during_dropout(run, world, student):
+    """When the lidar goes silent the robot stops within 0.5 s plus braking"""
+    _died(run, student)
+    samples, _collisions = world.recording.snapshot()
+    for d in run.dropouts:
+        moving = [s for s in samples if d.start + STOP_WITHIN <= s.t < d.end
+                  and (abs(s.v) > STILL_LINEAR or abs(s.w) > STILL_ANGULAR)]
+        sent = window(run.commands, d.start + STOP_WITHIN, d.end)
+        going = [m for m in sent if not is_zero(m)]
+        cycles = (d.end - d.start - STOP_WITHIN) * 10
+        if moving or going:
+            first = moving[0] if moving else None
+            raise StudentFailure(
+                _("The lidar went silent {start:.1f} s into the run; {after:.2f} s later the "
+                  "robot still moved ({how}).").format(
+                    start=d.start - run.start,
+                    after=(first.t if first else d.start + STOP_WITHIN) - d.start,
+                    how=(_("v={v:.2f} m/s, w={w:.2f} rad/s").format(v=first.v, w=first.w)
+                         if first else describe(going[0]))),
+                _("A watchdog: remember when the last scan came and publish Twist() on every "
+                  "cycle once it is more than 0.5 s old (in ROS time)."))
+        if len(sent) < cycles - 3:
+            raise StudentFailure(
+                _("While the lidar was silent ({seconds:.1f} s into the run) cmd_vel was "
+                  "published {count} times in {span:.1f} s; a stop is due on every 10 Hz "
+                  "cycle.").format(seconds=d.start - run.start, count=len(sent),
+                                   span=d.end - d.start - STOP_WITHIN),
+                _("Publish from the timer, not from the scan callback."))
+
+
+@pytest.mark.points(1)
+def test_moves_after_dropout(run, world, student):
+    """When scans come back the robot moves again"""
+    _died(run, student)
+    samples, _collisions = world.recording.snapshot()
+    for d in run.dropouts:
+        if not any(d.end <= s.t <= d.end + MOVE_WITHIN and (abs(s.v) > 0.05 or abs(s.w) > 0.2)
+                   for s in samples):
+            raise StudentFailure(
+                _("Scans came back {seconds:.1f} s into the run, but the robot did not move "
+                  "within {within} s.").format(seconds=d.end - run.start, within=MOVE_WITHIN),
+                _("The watchdog must let go as soon as a scan arrives."))
+
+
+@pytest.mark.points(1)
+def test_log_not_flooded(run, student):
+    """A dropout is reported with a warning, at most about one a second"""
+    _died(run, student)
+    for d in run.dropouts:
+        count = warnings_between(run.output, d.wall_start, d.wall_end)
+        # Throttled by wall or by ROS time, whichever is longer: both are fair.
+        allowed = math.ceil(max(d.end - d.start, d.wall_end - d.wall_start)) + 1
+        if count == 0:
+            raise StudentFailure(
+                _("The lidar was silent for {span:.0f} s ({seconds:.1f} s into the run) and "
+                  "the node logged no warning.").format(
+                    span=d.end - d.start, seconds=d.start - run.start),
+                _("Log it: self.get_logger().warn('no scan ...', throttle_duration_sec=1.0)."))
+        if count > allowed:
+            raise StudentFailure(
+                _("The lidar was silent for {span:.0f} s and the node logged {count} "
+                  "warnings; at most about one a second ({allowed}) is useful.").format(
+                    span=d.end - d.start, count=count, allowed=allowed),
+                _("Throttle the warning: get_logger().warn(..., throttle_duration_sec=1.0)."))

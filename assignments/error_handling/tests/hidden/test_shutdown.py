@@ -1,0 +1,82 @@
+"""Hidden tests: Ctrl-C (SIGINT) and SIGTERM leave the robot stopped and exit cleanly.
+
+A shutdown that is clean only most of the time is a bug that shows up on the real robot,
+so each signal is tried on TRIALS fresh instances of the node; every one must be clean.
+Exiting is the process's business, so it is timed in wall seconds: the contract says
+2 s, and EXIT_WITHIN allows for a busy grading machine.
+"""
+
+from __future__ import annotations
+
+import signal
+
+import pytest
+from geometry_msgs.msg import Twist
+from helpers import describe, is_zero
+
+from autograder.errors import StudentFailure
+from autograder.i18n import _
+
+pytestmark = pytest.mark.world("empty_room")
+
+TRIALS = 3
+EXIT_WITHIN = 5.0
+HINT = _("Use rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO), spin an "
+         "executor in a thread, wait on a threading.Event set by your own SIGINT/SIGTERM "
+         "handlers, then stop spinning, publish Twist(), wait_for_all_acked, destroy the node "
+         "and return 0 (see the README).")
+
+
+def _trial(probe, start_node, sig: signal.Signals, trial: int) -> None:
+    commands = probe.subscribe(Twist, "/cmd_vel")
+    node = start_node()
+    if not probe.wait_for(lambda: bool(commands.messages) and not is_zero(commands.messages[-1]),
+                          5.0):
+        raise StudentFailure(
+            _("A fresh node never published a moving command within 5 s, so its shutdown "
+              "could not be judged."),
+            _("Drive forward at 0.2 m/s when the way ahead is clear."))
+    node.send_signal(sig)
+    code = node.wait_exit(EXIT_WITHIN)
+    name = sig.name
+    if code is None:
+        raise StudentFailure(
+            _("After {signal} (trial {trial} of {trials}) the process was still running "
+              "{seconds:.0f} s later.").format(signal=name, trial=trial, trials=TRIALS,
+                                                seconds=EXIT_WITHIN), HINT)
+    output = node.output()
+    if code != 0 or "Traceback" in output:
+        raise StudentFailure(
+            _("After {signal} (trial {trial} of {trials}) the process exited with status "
+              "{code}{traceback}. Its last lines:\n{tail}").format(
+                signal=name, trial=trial, trials=TRIALS, code=code,
+                traceback=_(" and a traceback") if "Traceback" in output else "",
+                tail=node.output_tail(12)), HINT)
+
+    def stopped() -> bool:
+        messages = commands.messages
+        return bool(messages) and is_zero(messages[-1])
+
+    probe.wait_for(stopped, 1.0)
+    probe.wait_sim(0.3)  # anything still on its way arrives by now
+    if not stopped():
+        last = commands.messages[-1]
+        raise StudentFailure(
+            _("After {signal} (trial {trial} of {trials}) the last command on cmd_vel was "
+              "{got}: the robot would drive on with nobody in charge. The last message must "
+              "be a zero Twist.").format(signal=name, trial=trial, trials=TRIALS,
+                                         got=describe(last)), HINT)
+
+
+@pytest.mark.points(2)
+def test_clean_exit_on_sigint(probe, start_node):
+    """On Ctrl-C (SIGINT) it stops the robot and exits with status 0, no traceback"""
+    for trial in range(1, TRIALS + 1):
+        _trial(probe, start_node, signal.SIGINT, trial)
+
+
+@pytest.mark.points(2)
+def test_clean_exit_on_sigterm(probe, start_node):
+    """On SIGTERM it stops the robot and exits with status 0, no traceback"""
+    for trial in range(1, TRIALS + 1):
+        _trial(probe, start_node, signal.SIGTERM, trial)

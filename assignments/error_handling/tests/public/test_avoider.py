@@ -1,0 +1,201 @@
+"""Public tests: the grader feeds made-up scans on /scan and reads cmd_vel.
+
+The world's own lidar is switched off (a dropout with no end) so that only the grader's
+scans reach the node.  Tests that may kill a careless node come last; a node that died
+in one test is started afresh for the next.
+"""
+
+import math
+
+import pytest
+from helpers import (
+    CLEAR,
+    FORWARD,
+    LATE,
+    TURN,
+    ScanFeeder,
+    alive,
+    blocked,
+    describe,
+    is_forward,
+    is_zero,
+    make_scan,
+    settle_forward,
+    turn_of,
+    wait_command,
+    window,
+)
+from sensor_msgs.msg import LaserScan
+
+from autograder.errors import StudentFailure
+from autograder.i18n import _
+from sim.worldfile import Fault
+
+pytestmark = pytest.mark.world("empty_room")
+
+
+@pytest.fixture(scope="module")
+def feeder(world, probe):
+    """Silence the world's lidar; the grader's scans are all the node sees."""
+    world.inject(Fault(kind="dropout", start=world.now))
+    return ScanFeeder(probe)
+
+
+@pytest.fixture
+def avoider(feeder, student, start_node, probe, commands):
+    """The module's node, or a fresh one if an earlier test killed it."""
+    node = student if student.running() else start_node()
+    if not probe.wait_for_subscriber(LaserScan, "/scan", 5.0):
+        raise StudentFailure(
+            _("Nothing subscribes to scan."),
+            _("Create a subscription: self.create_subscription(LaserScan, 'scan', ...)."))
+    return node
+
+
+@pytest.mark.points(1)
+def test_publishes_at_10_hz(avoider, feeder, probe, commands):
+    """The node subscribes to scan and publishes cmd_vel from a 10 Hz timer"""
+    feeder.feed(CLEAR)
+    probe.wait_sim(0.5)
+    start = probe.now
+    probe.wait_sim(3.0)
+    count = len(window(commands, start, start + 3.0))
+    if not 27 <= count <= 33:
+        raise StudentFailure(
+            _("In 3 s of simulation time cmd_vel was published {count} times; a 10 Hz timer "
+              "gives 30.").format(count=count),
+            _("Publish exactly once per cycle of self.create_timer(0.1, ...), not from the "
+              "scan callback."))
+
+
+@pytest.mark.points(1)
+def test_drives_when_clear(avoider, feeder, probe, commands):
+    """With a clear way ahead, it drives forward at 0.2 m/s"""
+    start = settle_forward(probe, commands, feeder, avoider)
+    probe.wait_sim(1.0)
+    wrong = [m for m in window(commands, start, probe.now) if not is_forward(m)]
+    if wrong:
+        raise StudentFailure(
+            _("With a clear way ahead cmd_vel said {got}; expected linear.x={v}, "
+              "angular.z=0 on every cycle.").format(got=describe(wrong[0]), v=FORWARD))
+
+
+@pytest.mark.points(2)
+def test_turns_toward_room(avoider, feeder, probe, commands):
+    """Blocked within 0.6 m ahead, it turns in place toward the side with more room"""
+    for toward, side in ((1, _("left")), (-1, _("right"))):
+        settle_forward(probe, commands, feeder, avoider)
+        since = feeder.feed(blocked(toward))
+        turned = wait_command(probe, commands, since, lambda m: not is_forward(m), 1.0)
+        if turned is None or turn_of(turned) != toward:
+            raise StudentFailure(
+                _("An obstacle 0.4 m ahead, open space on the {side}: cmd_vel said {got}; "
+                  "expected linear.x=0, angular.z={z}.").format(
+                    side=side, got=describe(turned) if turned else _("nothing new"),
+                    z=toward * TURN),
+                _("Turn in place (linear.x=0) at ±0.5 rad/s, positive to the left, toward "
+                  "the side whose valid readings are farther."))
+
+
+@pytest.mark.points(2)
+def test_watchdog_stops(avoider, feeder, probe, commands):
+    """When scans stop for 0.5 s it publishes a stop every cycle, then moves when they return"""
+    settle_forward(probe, commands, feeder, avoider)
+    silent = feeder.feed(None)
+    probe.wait_sim(2.5)
+    late = window(commands, silent + 0.5 + 0.2 + LATE, probe.now)
+    moving = [m for m in late if not is_zero(m)]
+    if moving or len(late) < 13:
+        raise StudentFailure(
+            _("With no scan for 2.5 s of simulation time, cmd_vel from 0.85 s on had "
+              "{count} messages, {moving} of them not a stop ({got}); expected a zero Twist "
+              "on every 10 Hz cycle once 0.5 s pass without a scan.").format(
+                count=len(late), moving=len(moving),
+                got=describe(moving[0]) if moving else "-"),
+            _("Remember when the last scan came (self.get_clock().now()); in the timer, "
+              "publish Twist() when it is more than 0.5 s old."))
+    settle_forward(probe, commands, feeder, avoider)
+
+
+@pytest.mark.points(2)
+def test_rejects_malformed_scans(avoider, feeder, probe, commands):
+    """An empty scan, or one whose length disagrees with its angles, gives a stop"""
+    for bad, what in ((make_scan(count=0), _("an empty scan")),
+                      (make_scan(count=180), _("a scan of 180 ranges whose angles say 360"))):
+        settle_forward(probe, commands, feeder, avoider)
+        since = feeder.feed(bad)
+        probe.wait_sim(0.6)
+        stop = wait_command(probe, commands, since, is_zero, 0.1)
+        going = [m for m in window(commands, since + 0.2 + LATE, probe.now) if not is_zero(m)]
+        alive(avoider, _("after it was sent {what}").format(what=what))
+        if stop is None or going:
+            raise StudentFailure(
+                _("After {what}, cmd_vel said {got}; expected a zero Twist for that "
+                  "cycle.").format(what=what, got=describe(going[0]) if going else
+                                   _("nothing")),
+                _("Before using a scan, check len(ranges) against (angle_max - angle_min) / "
+                  "angle_increment + 1; reject an empty or mismatched scan with a stop."))
+    settle_forward(probe, commands, feeder, avoider)
+
+
+RANGE_BELOW, RANGE_ABOVE = 0.05, 9.0
+
+
+def _invalid(b: float) -> float:
+    """Ahead: nothing but readings to ignore; elsewhere 2 m."""
+    if abs(b) > 25:
+        return 2.0
+    return (math.nan, math.inf, -math.inf, RANGE_BELOW, RANGE_ABOVE)[int(b) % 5]
+
+
+def _hidden_obstacle(b: float) -> float:
+    """A real obstacle 0.45 m ahead among NaN readings."""
+    if abs(b) <= 6:
+        return 0.45
+    return math.nan if abs(b) <= 25 else 2.0
+
+
+@pytest.mark.points(2)
+def test_ignores_invalid_readings(avoider, feeder, probe, commands):
+    """NaN, ±inf and out-of-range readings are ignored; valid ones still count"""
+    settle_forward(probe, commands, feeder, avoider)
+    since = feeder.feed(make_scan(_invalid))
+    probe.wait_sim(1.0)
+    alive(avoider, _("after a scan with NaN and ±inf readings"))
+    wrong = [m for m in window(commands, since + LATE, probe.now) if not is_forward(m)]
+    if wrong:
+        raise StudentFailure(
+            _("Ahead were only NaN, inf, -inf, 0.05 m (below range_min) and 9 m (above "
+              "range_max) readings, the rest 2 m away: cmd_vel said {got}; expected forward "
+              "at {v} m/s.").format(got=describe(wrong[0]), v=FORWARD),
+            _("Skip a reading unless range_min <= r <= range_max (false for NaN and inf)."))
+    since = feeder.feed(make_scan(_hidden_obstacle))
+    turned = wait_command(probe, commands, since, lambda m: turn_of(m) != 0, 1.0)
+    alive(avoider, _("after a scan with NaN readings"))
+    if turned is None:
+        raise StudentFailure(
+            _("An obstacle 0.45 m ahead, between NaN readings, did not make the robot turn "
+              "in place within 1 s."),
+            _("Ignore only the invalid readings: the valid ones ahead still decide."))
+    settle_forward(probe, commands, feeder, avoider)
+
+
+@pytest.mark.points(2)
+def test_survives_exceptions(avoider, feeder, probe, commands):
+    """A scan that makes a careless node raise gives a stop, and the node lives on"""
+    for bad, what in ((make_scan(angle_increment=0.0), _("angle_increment 0")),
+                      (make_scan(angle_increment=math.nan), _("angle_increment NaN"))):
+        settle_forward(probe, commands, feeder, avoider)
+        since = feeder.feed(bad)
+        probe.wait_sim(0.6)
+        alive(avoider, _("after a scan with {what}").format(what=what))
+        stop = wait_command(probe, commands, since, is_zero, 0.1)
+        going = [m for m in window(commands, since + 0.2 + LATE, probe.now) if not is_zero(m)]
+        if stop is None or going:
+            raise StudentFailure(
+                _("After a scan with {what}, cmd_vel said {got}; expected a zero Twist.")
+                .format(what=what, got=describe(going[0]) if going else _("nothing")),
+                _("Wrap the work of each callback in try/except Exception: log the error "
+                  "with get_logger().error(...) and publish Twist()."))
+    settle_forward(probe, commands, feeder, avoider)
+    alive(avoider, _("after the scans it could not use"))
