@@ -334,6 +334,29 @@ def gradebook_merge(out: Path, inputs: tuple[Path, ...]) -> None:
     click.echo(_("{count} rows in {path}").format(count=len(rows), path=out))
 
 
+@main.command()
+@click.argument("kind", type=click.Choice(["github-student", "github-shards", "k8s-shards"]))
+@click.option("--exercise", default="parameter_validation", show_default=True)
+@click.option("--submission", default=".", show_default=True,
+              help="Where the student's file is in their repository.")
+@click.option("--shards", type=click.IntRange(1, 256), default=4, show_default=True)
+@click.option("--platform-repo", default="https://github.com/COURSE/rclpy-autograder-release",
+              show_default=True, help="Git URL pip installs the platform from.")
+@click.option("--hidden-repo", default="COURSE/rclpy-hidden-tests", show_default=True,
+              help="Private repository holding the course tree with hidden tests.")
+@click.option("--claim", default="grading-data", show_default=True,
+              help="Kubernetes volume claim with submissions/ and out/.")
+def workflow(kind: str, exercise: str, submission: str, shards: int, platform_repo: str,
+             hidden_repo: str, claim: str) -> None:
+    """Print a CI workflow: a student repository's grade-on-push (github-student), or a
+    course's sharded batch grading (github-shards, k8s-shards)."""
+    from autograder.workflows import render_workflow
+
+    click.echo(render_workflow(kind, exercise=exercise, submission=submission, shards=shards,
+                               platform_repo=platform_repo, hidden_repo=hidden_repo,
+                               claim=claim), nl=False)
+
+
 main.add_command(sim_cli, "sim")
 main.add_command(quiz_cli, "quiz")
 main.add_command(i18n_cli, "i18n")

@@ -1,0 +1,47 @@
+"""The CI templates render to valid YAML that runs our commands."""
+
+import yaml
+from click.testing import CliRunner
+
+from autograder.cli import main
+from autograder.workflows import render_workflow
+
+VALUES = {"exercise": "timer_sync", "submission": "src", "shards": 5,
+          "platform_repo": "https://example.invalid/platform", "hidden_repo": "course/hidden",
+          "claim": "data"}
+
+
+def test_student_workflow_runs_public_and_hidden_tests():
+    text = render_workflow("github-student", **VALUES)
+    flow = yaml.safe_load(text)
+    steps = flow["jobs"]["grade"]["steps"]
+    runs = " ".join(s.get("run", "") for s in steps)
+    assert "autograder check timer_sync src" in runs
+    assert "autograder grade timer_sync src" in runs
+    assert "${{ secrets.HIDDEN_TESTS_TOKEN }}" in text
+    assert any(s.get("with", {}).get("repository") == "course/hidden" for s in steps)
+
+
+def test_github_matrix_shards_and_merges():
+    flow = yaml.safe_load(render_workflow("github-shards", **VALUES))
+    assert flow["jobs"]["shard"]["strategy"]["matrix"]["shard"] == [1, 2, 3, 4, 5]
+    shard_runs = " ".join(s.get("run", "") for s in flow["jobs"]["shard"]["steps"])
+    assert "--shard ${{ matrix.shard }}/5" in shard_runs
+    merge_runs = " ".join(s.get("run", "") for s in flow["jobs"]["merge"]["steps"])
+    assert "autograder gradebook merge gradebook.csv" in merge_runs
+    assert flow["jobs"]["merge"]["needs"] == "shard"
+
+
+def test_kubernetes_indexed_job():
+    job = yaml.safe_load(render_workflow("k8s-shards", **VALUES))
+    assert job["kind"] == "Job" and job["spec"]["completionMode"] == "Indexed"
+    assert job["spec"]["completions"] == job["spec"]["parallelism"] == 5
+    args = job["spec"]["template"]["spec"]["containers"][0]["args"][0]
+    assert "--shard $((JOB_COMPLETION_INDEX + 1))/5" in args
+    assert job["metadata"]["name"] == "grade-timer-sync"
+
+
+def test_cli_prints_a_workflow():
+    result = CliRunner().invoke(main, ["workflow", "k8s-shards", "--shards", "2"])
+    assert result.exit_code == 0
+    assert yaml.safe_load(result.output)["spec"]["completions"] == 2
