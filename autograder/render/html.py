@@ -13,7 +13,7 @@ from typing import Any
 from markupsafe import Markup
 
 from autograder.i18n import is_rtl
-from autograder.quiz.localize import Text, format_percent
+from autograder.quiz.localize import Text, format_percent, using_language
 from autograder.quiz.render import environment
 from autograder.render.charts import intervals_svg
 from autograder.results import RunResult, number
@@ -54,6 +54,12 @@ def to_html(result: RunResult, exercise_folder: Path | None = None) -> str:
                        for chart in test.data.get("charts", [])],
             "score": number(test.score), "max_score": number(test.max_score),
         })
+    with using_language(lang):
+        return _render(result, tests, exercise_folder)
+
+
+def _render(result: RunResult, tests: list[dict[str, Any]], exercise_folder: Path | None) -> str:
+    lang = result.lang
     return environment().get_template("report.html").render(
         lang=lang, dir="rtl" if is_rtl(lang) else "ltr", result=result,
         title=Text(result.title, lang), tests=tests,

@@ -1,0 +1,80 @@
+"""The Urdu HTML report in headless Chromium: right to left, Nastaliq unclipped, code LTR,
+pictures drawn. The screenshot is kept at /tmp/report-ur.png for a person to look at."""
+
+from __future__ import annotations
+
+import math
+from fractions import Fraction
+from pathlib import Path
+
+from browser import chromium_page, ink
+
+from autograder.render.html import to_html
+from autograder.results import RunResult, TestResult
+from sim.recorder import Recording, Sample
+
+SCREENSHOT = Path("/tmp/report-ur.png")
+
+
+def urdu_result() -> RunResult:
+    # A quarter circle through the empty room, as a recorded run would give.
+    samples = [Sample(t=i * 0.1, x=3 + math.sin(i / 20), y=3 + 1 - math.cos(i / 20),
+                      theta=i / 20, v=0.2, w=0.1) for i in range(32)]
+    recording = Recording(world="empty_room", samples=samples, collisions=[])
+    tests = (
+        TestResult("test_node_starts", "node شروع ہوتا ہے اور `velocity_governor` کے نام سے "
+                   "graph پر نظر آتا ہے", Fraction(1), Fraction(1), "passed"),
+        TestResult("test_rate", "`cmd_vel` دس Hz پر رہتا ہے", Fraction(0), Fraction(2),
+                   "failed", message="`cmd_vel` simulation time میں 3.1 Hz پر آیا؛ planner "
+                   "کے چلتے ہوئے بھی control loop کو 10 Hz رکھنا ہے۔",
+                   hint="کیا planner اپنے callback group میں ہے؟",
+                   data={"charts": [{"kind": "intervals", "title": "cmd_vel",
+                                     "points": [[0.1 * i, 0.1] for i in range(1, 30)]
+                                     + [[3.5, 0.6]], "limit": 0.15}]}),
+    )
+    return RunResult("exercise", "timer_sync", "Timer synchronization: ایک multi-rate controller",
+                     tests, lang="ur", log_tail="[INFO] [multi_rate_controller]: started",
+                     data={"recordings": {"test_world.py": recording.to_dict()}})
+
+
+_LAYOUT_JS = """
+() => {
+  const out = [];
+  for (const el of document.querySelectorAll("h1, .test h3 span:not(.mark):not(.points), .message")) {
+    const c = el.getBoundingClientRect();
+    const r = document.createRange(); r.selectNodeContents(el);
+    const t = r.getBoundingClientRect();
+    out.push({ct: c.top, cb: c.bottom, cr: c.right, tt: t.top, tb: t.bottom, tr: t.right,
+              overflow: el.scrollHeight - el.clientHeight});
+  }
+  const code = document.querySelector(".message code");
+  return {items: out, direction: getComputedStyle(document.body).direction,
+          font: getComputedStyle(document.body).fontFamily,
+          nastaliq: document.fonts.check('20px "Noto Nastaliq Urdu"', "کیا"),
+          code: getComputedStyle(code).direction,
+          pictures: document.querySelectorAll("svg.sim-trajectory, svg.chart").length};
+}
+"""
+
+
+def test_urdu_report_renders_rtl_in_nastaliq_unclipped(tmp_path: Path) -> None:
+    page_file = tmp_path / "report.ur.html"
+    page_file.write_text(to_html(urdu_result()), encoding="utf-8")
+    with chromium_page() as page:
+        page.goto(page_file.as_uri())
+        page.evaluate("document.fonts.ready")
+        layout = page.evaluate(_LAYOUT_JS)
+        png = page.screenshot(full_page=True, path=str(SCREENSHOT))
+        title = page.locator("h1").bounding_box()
+        stats = ink(page, png)
+        title_ink = ink(page, png, (0, int(title["y"]), 900, int(title["height"])))
+    assert layout["direction"] == "rtl"
+    assert layout["font"].startswith('"Noto Nastaliq Urdu"')
+    assert layout["nastaliq"], "Noto Nastaliq Urdu is not available (fonts-noto-core)"
+    assert layout["code"] == "ltr"
+    assert layout["pictures"] == 2  # the robot's path and the interval plot
+    for item in layout["items"]:
+        assert item["tt"] >= item["ct"] - 1 and item["tb"] <= item["cb"] + 1, item
+        assert item["overflow"] <= 0, item
+    assert stats["ink"] > 10_000
+    assert title_ink["right"] > 900 * 0.85  # the title starts on the right
