@@ -108,13 +108,17 @@ class Probe:
         """
         wall = wall_timeout if wall_timeout is not None else max(10.0, 4.0 * sim_timeout)
         start = self.now
+
+        def elapsed() -> bool:  # sim time is steps * dt: 12.4 - 12.3 may be 0.0999...
+            return self.now - start >= sim_timeout - 1e-9
+
         if condition():
             return True
-        done = self.world.wait_for(lambda: condition() or self.now - start >= sim_timeout,
+        done = self.world.wait_for(lambda: condition() or elapsed(),
                                    sim_timeout=sim_timeout, wall_timeout=wall)
         if condition():
             return True
-        if not done and self.now - start < sim_timeout:
+        if not done and not elapsed():
             raise StudentFailure(
                 _("The simulation could not advance for {seconds:.0f} s of wall time: the "
                   "node kept the machine too busy.").format(seconds=wall),
