@@ -19,6 +19,9 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent
 VENV = Path(os.environ.get("AUTOGRADER_VENV", ROOT / ".venv"))
+# The interpreter the venv is made from. Strict isolation runs students as another user,
+# who must be able to read it: CI uses Debian's /usr/bin/python3 and a venv in /opt.
+PYTHON = os.environ.get("AUTOGRADER_PYTHON", sys.executable)
 BIN = VENV / "bin"
 STAMP = VENV / ".installed"
 
@@ -49,7 +52,11 @@ def setup() -> None:
         print(f"creating {VENV}" + (" (with the system's ROS 2 Jazzy)" if system_ros else ""),
               flush=True)
         try:
-            venv.create(VENV, with_pip=True, system_site_packages=system_ros)
+            if Path(PYTHON).resolve() == Path(sys.executable).resolve():
+                venv.create(VENV, with_pip=True, system_site_packages=system_ros)
+            else:
+                subprocess.run([PYTHON, "-m", "venv", str(VENV)]
+                               + (["--system-site-packages"] if system_ros else []), check=True)
         except subprocess.CalledProcessError:
             sys.exit("Could not create a virtual environment: on Debian or Ubuntu install "
                      "python3-venv first (apt-get install python3-venv).")

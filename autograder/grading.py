@@ -8,6 +8,7 @@ is stopped with everything it started.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import signal
@@ -23,6 +24,7 @@ from typing import Any
 from autograder.domains import reserve_domain
 from autograder.exercise import Exercise
 from autograder.i18n import _, get_language
+from autograder.isolation import dds_env, detect, run_prefix
 from autograder.results import RunResult, TestResult, exact
 from autograder.sandbox import Cgroup
 
@@ -39,13 +41,14 @@ def grade(exercise: Exercise, submission: Path | None, *, hidden: bool = True,
     of ours sets ``grader_error``.
     """
     started = time.monotonic()
+    isolation = detect()
     folders = [exercise.public_tests] + ([exercise.hidden_tests] if hidden else [])
     folders = [f for f in folders if f.is_dir()]
     with tempfile.TemporaryDirectory(prefix="autograder-") as tmp, \
             reserve_domain(domain) as ros_domain:
         report_path = Path(tmp) / "report.json"
         command = [
-            sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
+            *run_prefix(isolation), sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
             "--rootdir", str(exercise.folder), "--basetemp", str(Path(tmp) / "pytest"),
             "--exercise", str(exercise.folder), "--autograder-report", str(report_path),
             "--ros-domain", str(ros_domain), *(str(f) for f in folders),
@@ -56,7 +59,12 @@ def grade(exercise: Exercise, submission: Path | None, *, hidden: bool = True,
             command += ["--real-time-factor", str(real_time_factor)]
         env = dict(os.environ, AUTOGRADER_LANG=get_language(), ROS_DOMAIN_ID=str(ros_domain),
                    AUTOGRADER_COURSE=str(exercise.folder.parent.parent),
-                   PYTHONDONTWRITEBYTECODE="1")
+                   AUTOGRADER_RUN_ISOLATION=isolation.mode, PYTHONDONTWRITEBYTECODE="1")
+        for key, value in dds_env(isolation).items():
+            if value is None:
+                env.pop(key, None)
+            else:
+                env[key] = value
         log_path = Path(tmp) / "pytest.log"
         with log_path.open("wb") as log:
             child = subprocess.Popen(command, cwd=tmp, env=env, stdout=log,
@@ -66,8 +74,9 @@ def grade(exercise: Exercise, submission: Path | None, *, hidden: bool = True,
         report = _read_report(report_path)
         _reap(child, report)
         pytest_log = log_path.read_text(errors="replace")
-    return _result(exercise, report, child.returncode, timed_out, pytest_log,
-                   time.monotonic() - started)
+    result = _result(exercise, report, child.returncode, timed_out, pytest_log,
+                     time.monotonic() - started)
+    return dataclasses.replace(result, data={**result.data, "isolation": isolation.to_dict()})
 
 
 def _wait(child: subprocess.Popen[bytes], limit: float, report_path: Path,

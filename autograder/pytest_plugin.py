@@ -16,6 +16,7 @@ from __future__ import annotations
 import itertools
 import json
 import os
+import shutil
 import tempfile
 import time
 import traceback
@@ -31,6 +32,7 @@ from autograder.i18n import _, set_language
 reporter_key = pytest.StashKey["GradingReporter"]()
 credit_key = pytest.StashKey["Credit"]()
 evidence_key = pytest.StashKey["Evidence"]()
+startup_key = pytest.StashKey[StudentFailure]()
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:
@@ -277,8 +279,12 @@ def ros_context(pytestconfig: pytest.Config) -> Iterator[Any]:
     from rclpy.context import Context
 
     from autograder.domains import reserve_domain
+    from autograder.isolation import bring_up_loopback
 
-    os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+    if _strict():
+        bring_up_loopback()  # the run's own network namespace starts with lo down
+    else:
+        os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
     given = pytestconfig.getoption("ros_domain")
     with reserve_domain(None) if given is None else _held(given) as domain:
         os.environ["ROS_DOMAIN_ID"] = str(domain)
@@ -288,6 +294,11 @@ def ros_context(pytestconfig: pytest.Config) -> Iterator[Any]:
             yield context
         finally:
             rclpy.try_shutdown(context=context)
+
+
+def _strict() -> bool:
+    """True inside a grading run in its own namespaces (see autograder.isolation)."""
+    return os.environ.get("AUTOGRADER_RUN_ISOLATION") == "strict"
 
 
 class _held:
@@ -339,6 +350,45 @@ def probe(ros_context: Any, world: Any) -> Iterator[Any]:
         node.close()
 
 
+# Topics only the world publishes, and names only the grader's nodes carry.
+WORLD_TOPICS = ("/clock", "/odom", "/scan")
+GRADER_NODES = ("autograder_probe", "sim_world")
+
+
+def tampering(probe: Any) -> list[str]:
+    """What on the graph impersonates the world or the grader, in plain words."""
+    found = []
+    for topic in WORLD_TOPICS:
+        for info in probe.node.get_publishers_info_by_topic(topic):
+            if info.node_name not in GRADER_NODES:
+                found.append(_("node '{node}' publishes on {topic}, which the simulator "
+                               "owns").format(node=info.node_name, topic=topic))
+    names = [name for name, _ns in probe.node.get_node_names_and_namespaces()]
+    for name in GRADER_NODES:
+        if names.count(name) > 1:
+            found.append(_("a second node is named '{name}', the grader's name").format(
+                name=name))
+    return found
+
+
+@pytest.fixture(autouse=True)
+def _graph_guard(request: pytest.FixtureRequest) -> Iterator[None]:
+    """Fail any test during which the student tampered with the graph: not rewarded."""
+    if "probe" not in request.fixturenames or not request.config.getoption("exercise"):
+        yield
+        return
+    probe = request.getfixturevalue("probe")
+    before = tampering(probe)
+    yield
+    seen = before + [t for t in tampering(probe) if t not in before]
+    if seen:
+        raise StudentFailure(
+            _("Tampering with the simulated world: {what}. Tests run while it happens are "
+              "not graded.").format(what="; ".join(seen)),
+            _("Publish only on the topics the exercise names; the world owns /clock, /odom "
+              "and /scan."))
+
+
 class StudentNode:
     """The student's running program, seen from the graph."""
 
@@ -372,6 +422,8 @@ class StudentNode:
     def stop(self) -> int | None:
         status = self.process.stop()
         self.probe.world.unwatch_pid(self.process.pid)
+        if self.process.uid is not None:  # strict: our own folder in /tmp, not the run's
+            shutil.rmtree(self.process.workdir, ignore_errors=True)
         return status
 
 
@@ -390,6 +442,7 @@ def launch(request: pytest.FixtureRequest, exercise: Any, script: Path, probe: A
            world: Any, params: dict[str, Any] | None = None,
            wait_for_node: bool = True) -> StudentNode:
     """Start the student's program with ``use_sim_time:=true`` and wait for its node."""
+    from autograder.isolation import dds_env, protected_paths, student_uid
     from autograder.sandbox import StudentProcess, minimal_env
 
     source = script.read_text(encoding="utf-8", errors="replace")
@@ -404,13 +457,19 @@ def launch(request: pytest.FixtureRequest, exercise: Any, script: Path, probe: A
     ros_args = ["-p", "use_sim_time:=true"]
     for key, value in (params or {}).items():
         ros_args += ["-p", f"{key}:={_ros_value(value)}"]
-    workdir = Path(tempfile.mkdtemp(prefix="student-", dir=script.parent.parent))
-    (workdir / script.name).write_bytes(script.read_bytes())
-    for sibling in script.parent.glob("*.py"):
-        if sibling.name != script.name:
-            (workdir / sibling.name).write_bytes(sibling.read_bytes())
-    env = minimal_env(workdir, {"ROS_DOMAIN_ID": os.environ["ROS_DOMAIN_ID"]})
+    strict = _strict()
+    # Strict: a folder outside the grader's (0700) run folder, turned into the student's
+    # own tmpfs by the launcher. Basic: a throwaway folder beside the staged copy.
+    workdir = Path(tempfile.mkdtemp(prefix="autograder-student-" if strict else "student-",
+                                    dir=None if strict else script.parent.parent))
+    for source in script.parent.glob("*.py"):
+        (workdir / source.name).write_bytes(source.read_bytes())
+    domain = int(os.environ["ROS_DOMAIN_ID"])
+    env = minimal_env(workdir, {"ROS_DOMAIN_ID": str(domain), **dds_env(detect_mode())})
     process = StudentProcess(workdir / script.name, workdir, ros_args, env, exercise.limits)
+    if strict:
+        process.uid = student_uid(domain)
+        process.hide = protected_paths(exercise.folder.parent.parent)
     process.start()
     reporter = request.config.stash.get(reporter_key, None)
     if reporter is not None:
@@ -418,10 +477,25 @@ def launch(request: pytest.FixtureRequest, exercise: Any, script: Path, probe: A
     world.watch_pid(process.pid)
     node = StudentNode(process, exercise.node, probe)
     if wait_for_node:
-        _wait_for_node(exercise, node, world)
+        earlier = request.config.stash.get(startup_key, None)
+        if earlier is not None:  # it already failed to appear once: do not wait again
+            node.stop()
+            raise StudentFailure(earlier.message, earlier.hint)
+        try:
+            _wait_for_node(exercise, node, world)
+        except NodeNeverAppeared as failure:
+            request.config.stash[startup_key] = failure
+            raise
         if reporter is not None:
             reporter.data.setdefault("startup_seconds", []).append(node.startup_seconds)
     return node
+
+
+def detect_mode() -> Any:
+    """The run's isolation, as the parent chose it (never detected again in here)."""
+    from autograder.isolation import Isolation
+
+    return Isolation(_strict())
 
 
 def _ros_value(value: Any) -> str:
@@ -430,6 +504,10 @@ def _ros_value(value: Any) -> str:
     if isinstance(value, str):
         return value if value else "''"
     return repr(value)
+
+
+class NodeNeverAppeared(StudentFailure):
+    """The program ran, but its node never showed up on the graph (not a crash)."""
 
 
 def _wait_for_node(exercise: Any, node: StudentNode, world: Any) -> None:
@@ -458,7 +536,7 @@ def _wait_for_node(exercise: Any, node: StudentNode, world: Any) -> None:
               "read the traceback.").format(file=exercise.file))
     others = sorted(seen - {"autograder_probe", "sim_world"})
     node.stop()
-    raise StudentFailure(
+    raise NodeNeverAppeared(
         _("No node named '{node}' appeared on the ROS graph within {seconds:.0f} s "
           "(nodes seen: {others}).\nLast lines of its output:\n{tail}").format(
             node=exercise.node, seconds=exercise.startup_timeout,

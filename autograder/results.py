@@ -132,6 +132,7 @@ class RunResult:
             "lang": self.lang,
             "grader_error": self.grader_error,
             "execution_time": round(self.execution_time, 3),
+            **({"isolation": self.data["isolation"]} if "isolation" in self.data else {}),
             "tests": [
                 {
                     "name": t.name,

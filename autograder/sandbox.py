@@ -81,7 +81,7 @@ class Cgroup:
                 pass
 
 
-def minimal_env(workdir: Path, extra: dict[str, str]) -> dict[str, str]:
+def minimal_env(workdir: Path, extra: dict[str, str | None]) -> dict[str, str]:
     env = {key: os.environ[key] for key in _PASS_THROUGH if key in os.environ}
     env.update({
         "HOME": str(workdir),
@@ -95,7 +95,11 @@ def minimal_env(workdir: Path, extra: dict[str, str]) -> dict[str, str]:
         "MALLOC_ARENA_MAX": "2",
     })
     env.setdefault("LANG", "C.UTF-8")
-    env.update(extra)
+    for key, value in extra.items():
+        if value is None:
+            env.pop(key, None)
+        else:
+            env[key] = value
     return env
 
 
@@ -139,6 +143,9 @@ class StudentProcess:
     popen: subprocess.Popen[bytes] | None = None
     cgroup: Cgroup | None = None
     output: _Output | None = None
+    uid: int | None = None
+    hide: list[Path] = dataclasses.field(default_factory=list)
+    workdir_mb: int = 64
     started_at: float = 0.0
     timed_out: bool = False
     _reader: threading.Thread | None = None
@@ -148,9 +155,12 @@ class StudentProcess:
         self.workdir.mkdir(parents=True, exist_ok=True)
         (self.workdir / ".ros" / "log").mkdir(parents=True, exist_ok=True)
         self.cgroup = Cgroup(f"run-{os.getpid()}-{uuid.uuid4().hex[:8]}", self.limits)
-        limits = dataclasses.asdict(self.limits)
-        command = [sys.executable, "-m", "autograder.sandbox_exec", json.dumps(limits),
-                   *(str(p) for p in self.cgroup.paths), "--",
+        spec: dict[str, object] = {"limits": dataclasses.asdict(self.limits),
+                                   "cgroups": [str(p) for p in self.cgroup.paths]}
+        if self.uid is not None:
+            spec.update(uid=self.uid, hide=[str(p) for p in self.hide],
+                        workdir=str(self.workdir), workdir_mb=self.workdir_mb)
+        command = [sys.executable, "-m", "autograder.sandbox_exec", json.dumps(spec), "--",
                    sys.executable, str(self.script), "--ros-args", *self.ros_args]
         self.output = _Output(self.limits.output_kb * 1024)
         launcher_env = dict(self.env)
