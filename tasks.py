@@ -43,8 +43,9 @@ def setup() -> None:
     if sys.version_info < (3, 10):  # noqa: UP036 - tasks.py is run by any python3
         sys.exit(f"Python 3.10 or newer is needed (found {sys.version.split()[0]})")
     pyproject = ROOT / "pyproject.toml"
-    if STAMP.exists() and STAMP.stat().st_mtime >= pyproject.stat().st_mtime:
-        return
+    if STAMP.exists() and STAMP.stat().st_mtime >= pyproject.stat().st_mtime \
+            and STAMP.read_text() == str(ROOT):
+        return  # installed, from this checkout, since pyproject.toml last changed
     # With a sourced system ROS 2 Jazzy (/opt/ros/jazzy, e.g. on an arm64 board), use its
     # rclpy and messages instead of the PyPI wheels, which exist for x86_64 only.
     system_ros = os.environ.get("ROS_DISTRO") == "jazzy" and "AMENT_PREFIX_PATH" in os.environ
@@ -67,7 +68,7 @@ def setup() -> None:
         subprocess.run([*pip, "--no-deps", "-e", f"{ROOT}[dev]"], check=True)
     else:
         subprocess.run([*pip, "-e", f"{ROOT}[dev]"], check=True)
-    STAMP.touch()
+    STAMP.write_text(str(ROOT))
 
 
 def main(argv: list[str]) -> int:
