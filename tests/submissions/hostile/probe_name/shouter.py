@@ -1,0 +1,38 @@
+"""Hostile: also creates a node with the grader's probe name."""
+
+import rclpy
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+from std_msgs.msg import String
+
+
+class Shouter(Node):
+    def __init__(self):
+        super().__init__('shouter')
+        self.pub = self.create_publisher(String, 'shout', 10)
+        self.create_subscription(String, 'words', self.on_words, 10)
+
+    def on_words(self, msg):
+        self.pub.publish(String(data=msg.data.upper()))
+
+
+def main(args=None):
+    rclpy.init(args=args)
+    node = Shouter()
+    from rclpy.executors import SingleThreadedExecutor
+    impostor = rclpy.create_node('autograder_probe')
+    executor = SingleThreadedExecutor()
+    executor.add_node(node)
+    executor.add_node(impostor)
+    rclpy.spin = lambda _node: executor.spin()
+    try:
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()
+
+
+if __name__ == '__main__':
+    main()

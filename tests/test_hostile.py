@@ -1,0 +1,181 @@
+"""Hostile and broken submissions: each ends with a score, a plain message and a results
+file, leaves no process behind, and leaves the grader unharmed and on time.
+
+The corpus (tests/submissions/hostile/) targets the small `shout` exercise of the fixture
+course, so the whole corpus grades in about a minute."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import socket
+import subprocess
+import sys
+import time
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import pytest
+
+from autograder.exercise import find_exercise
+from autograder.grading import grade
+from autograder.isolation import detect
+from autograder.leftovers import leftovers
+from autograder.results import RunResult
+
+pytestmark = pytest.mark.slow
+
+COURSE = Path(__file__).parent / "fixtures" / "mini_course"
+CORPUS = Path(__file__).parent / "submissions" / "hostile"
+NAMES = sorted(p.name for p in CORPUS.iterdir())
+TARGET = ("10.231.77.2", 8765)  # the network test's own host, in a namespace it makes
+
+
+@pytest.fixture(scope="module")
+def course():
+    old = os.environ.get("AUTOGRADER_COURSE")
+    os.environ["AUTOGRADER_COURSE"] = str(COURSE)
+    yield find_exercise("shout")
+    if old is None:
+        del os.environ["AUTOGRADER_COURSE"]
+    else:
+        os.environ["AUTOGRADER_COURSE"] = old
+
+
+@pytest.fixture(scope="module")
+def target_host():
+    """A TCP server in a network namespace of this test's own, reachable from the host."""
+    if os.geteuid() != 0 or shutil.which("ip") is None:
+        yield None
+        return
+    ns, host_if, peer_if = f"agtarget{os.getpid()}", f"agh{os.getpid()}", f"agt{os.getpid()}"
+    received = Path(f"/tmp/{ns}.received")
+
+    def ip(*args: str) -> None:
+        subprocess.run(["ip", *args], check=True, capture_output=True)
+
+    server = None
+    try:
+        ip("netns", "add", ns)
+        ip("link", "add", host_if, "type", "veth", "peer", "name", peer_if)
+        ip("link", "set", peer_if, "netns", ns)
+        ip("addr", "add", "10.231.77.1/24", "dev", host_if)
+        ip("link", "set", host_if, "up")
+        ip("netns", "exec", ns, "ip", "addr", "add", "10.231.77.2/24", "dev", peer_if)
+        ip("netns", "exec", ns, "ip", "link", "set", peer_if, "up")
+        ip("netns", "exec", ns, "ip", "link", "set", "lo", "up")
+        code = (f"import socket\ns = socket.create_server(('0.0.0.0', {TARGET[1]}))\n"
+                f"while True:\n    c, _ = s.accept()\n"
+                f"    open({str(received)!r}, 'ab').write(c.recv(100) or b'(connected)')\n"
+                f"    c.close()\n")
+        server = subprocess.Popen(["ip", "netns", "exec", ns, sys.executable, "-c", code])
+        deadline = time.monotonic() + 10
+        while True:  # the target is reachable from outside the sandbox: the test can fail
+            try:
+                socket.create_connection(TARGET, timeout=1).close()
+                break
+            except OSError:
+                if time.monotonic() > deadline:
+                    raise
+                time.sleep(0.1)
+        received.write_bytes(b"")
+        yield received
+    finally:
+        if server is not None:
+            server.kill()
+            server.wait()
+        subprocess.run(["ip", "netns", "del", ns], capture_output=True)
+        subprocess.run(["ip", "link", "del", host_if], capture_output=True)
+        received.unlink(missing_ok=True)
+
+
+@pytest.fixture(scope="module")
+def graded(course, target_host) -> dict[str, tuple[RunResult, float, list[int]]]:
+    def run(name: str) -> tuple[str, tuple[RunResult, float, list[int]]]:
+        began = time.monotonic()
+        result = grade(course, CORPUS / name)
+        return name, (result, time.monotonic() - began, leftovers(result))
+
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        return dict(pool.map(run, NAMES))
+
+
+def messages(result: RunResult) -> str:
+    return "\n".join(t.message for t in result.tests)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_ends_with_a_score_a_message_and_nothing_left(graded, course, name):
+    result, wall, left = graded[name]
+    assert result.grader_error is None, result.grader_details
+    assert left == [], f"processes left behind: {left}"
+    assert wall < course.time_limit
+    data = json.loads(json.dumps(result.to_dict()))
+    assert data["max_score"] == 3 and 0 <= data["score"] <= 3
+    for test in result.tests:
+        assert test.passed or test.message.strip(), test
+
+
+@pytest.mark.parametrize("name", ["import_loop", "sleep_forever", "fork_bomb", "memory_bomb",
+                                  "output_flood", "huge_file", "os_exit", "segfault",
+                                  "sys_exit_before_spin"])
+def test_programs_that_never_run_a_node_score_zero(graded, name):
+    assert graded[name][0].score == 0
+
+
+@pytest.mark.parametrize("name,expected", [
+    ("segfault", "SIGSEGV"), ("memory_bomb", "MemoryError"), ("huge_file", "File too large"),
+    ("output_flood", "bytes of output; only the first and last"),
+    ("os_exit", "exited with status 0"),
+    ("sys_exit_before_spin", "exited with status 0"),
+    ("import_loop", "No node named 'shouter'"),
+])
+def test_the_message_says_what_happened(graded, name, expected):
+    assert expected in messages(graded[name][0])
+
+
+@pytest.mark.parametrize("name", ["publishes_world_topics", "probe_name"])
+def test_tampering_is_caught_not_rewarded(graded, name):
+    result = graded[name][0]
+    assert result.score < result.max_score
+    assert "Tampering with the simulated world" in messages(result)
+
+
+def test_a_flood_does_not_stop_grading(graded):
+    result, wall, _ = graded["topic_flood"]
+    assert result.grader_error is None and result.score < result.max_score
+
+
+strict_only = pytest.mark.skipif(not detect().strict, reason=f"needs strict isolation: "
+                                 f"{detect().reason}")
+
+
+@strict_only
+def test_hidden_tests_and_solutions_are_out_of_reach(graded):
+    result = graded["reads_secrets"][0]
+    assert "SECRETS FOUND: 0" in result.log_tail
+    assert "SECRET /" not in result.log_tail
+
+
+@strict_only
+def test_results_and_grader_folders_cannot_be_written(graded):
+    result = graded["writes_results"][0]
+    assert "FORGED" not in result.log_tail and "PLANTED" not in result.log_tail
+    assert result.score == result.max_score  # it works otherwise, and its forgery failed
+
+
+@strict_only
+def test_no_network_beyond_loopback(graded, target_host):
+    if target_host is None:
+        pytest.skip("needs root and iproute2 to build the target host")
+    result = graded["network"][0]
+    assert "NETWORK: blocked" in result.log_tail
+    assert b"leaked" not in target_host.read_bytes()
+
+
+def test_runs_as_its_own_user_where_strict(graded):
+    isolation = graded["detached_daemon"][0].data["isolation"]
+    assert isolation["mode"] == detect().mode
+    if isolation["mode"] == "basic":
+        assert isolation["reason"]  # the results say why
