@@ -40,7 +40,8 @@ def urdu_result() -> RunResult:
 _LAYOUT_JS = """
 () => {
   const out = [];
-  for (const el of document.querySelectorAll("h1, .test h3 span:not(.mark):not(.points), .message")) {
+  const selector = "h1, .test h3 span:not(.mark):not(.points), .message";
+  for (const el of document.querySelectorAll(selector)) {
     const c = el.getBoundingClientRect();
     const r = document.createRange(); r.selectNodeContents(el);
     const t = r.getBoundingClientRect();
