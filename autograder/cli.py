@@ -15,7 +15,7 @@ import click
 
 from autograder import __version__
 from autograder.declarative import ContentError
-from autograder.i18n import LANGUAGES, _, get_language, set_language
+from autograder.i18n import LANGUAGES, _, get_language, ngettext, set_language
 from autograder.i18n_cli import i18n_cli
 from autograder.quiz.cli import quiz_cli
 from sim.cli import sim_cli
@@ -355,6 +355,34 @@ def workflow(kind: str, exercise: str, submission: str, shards: int, platform_re
     click.echo(render_workflow(kind, exercise=exercise, submission=submission, shards=shards,
                                platform_repo=platform_repo, hidden_repo=hidden_repo,
                                claim=claim), nl=False)
+
+
+@main.command()
+@click.option("--grade/--no-grade", "run_gradings", default=True, show_default=True,
+              help="Also grade every reference solution and starter.")
+@click.option("--jobs", type=click.IntRange(1, 16), default=2, show_default=True)
+@click.option("--course", type=click.Path(path_type=Path, file_okay=False, exists=True),
+              default=None, help="The course tree (default: the one in use).")
+def validate(run_gradings: bool, jobs: int, course: Path | None) -> None:
+    """Check a whole course: exercise files, starters and solutions, worlds, quizzes and
+    catalogs; the reference solutions score 100% and the starters below the pass mark."""
+    from autograder.validate import validate as check_course
+
+    problems = check_course(course, run_gradings=run_gradings, jobs=jobs,
+                            progress=lambda e: click.echo(_("grading {exercise}...").format(
+                                exercise=e), err=True))
+    for problem in problems:
+        click.echo(str(problem), err=True)
+    if problems:
+        raise Problems(ngettext("{count} problem found", "{count} problems found",
+                                len(problems)).format(count=len(problems)))
+    click.echo(_("The course is valid."))
+
+
+class Problems(click.ClickException):
+    """Validation found problems (each printed as file:line: message)."""
+
+    exit_code = 1
 
 
 main.add_command(sim_cli, "sim")

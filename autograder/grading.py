@@ -189,12 +189,11 @@ def _result(exercise: Exercise, report: dict[str, Any], returncode: int | None,
             details=raw.get("details", ""), data={"charts": raw.get("charts", [])}))
     grader_error = None
     details = ""
-    if errors:
-        grader_error, details = GRADER_FAULT, "\n\n".join(errors)
-    elif not tests:
-        grader_error, details = GRADER_FAULT, pytest_log[-4000:]
-    elif returncode not in (0, 1) and not timed_out:
-        grader_error, details = GRADER_FAULT, pytest_log[-4000:]
+    broken_run = returncode not in (0, 1) and not timed_out  # e.g. a test file that
+    if errors or not tests or broken_run:                    # does not import
+        grader_error = GRADER_FAULT
+        details = "\n\n".join(errors + ([pytest_log[-4000:]] if broken_run or not tests
+                                          else []))
     total = sum((t.max_score for t in tests), Fraction(0))
     if exercise.points and tests and total != exercise.points and grader_error is None:
         grader_error = GRADER_FAULT

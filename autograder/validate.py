@@ -1,0 +1,109 @@
+"""Check a whole course tree before a release: every exercise file loads, its files exist,
+its worlds load, its reference solution scores 100%, its starter scores below the pass
+mark, and every quiz lints.  Each problem is a ``file:line: message``."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+from autograder.declarative import ContentError, load_document
+from autograder.exercise import Exercise, assignments_dir, load_exercise
+from autograder.i18n import _
+from autograder.i18n_tools import Problem
+from autograder.results import RunResult, number
+
+
+def _from(exc: ContentError) -> Problem:
+    return Problem(exc.path, exc.line, f"{exc.field}: {exc.message}" if exc.field
+                   else exc.message)
+
+
+def _files(exercise: Exercise) -> list[Problem]:
+    problems = []
+    where = exercise.folder / "exercise.yaml"
+    for path, what in ((exercise.starter, _("starter file")),
+                       (exercise.solution, _("reference solution")),
+                       (exercise.folder / "README.md", _("README")),
+                       (exercise.public_tests, _("public tests folder"))):
+        if not path.exists():
+            problems.append(Problem(where, None, _("{what} {path} is missing").format(
+                what=what, path=path)))
+    return problems
+
+
+def _worlds(exercise: Exercise) -> list[Problem]:
+    from sim.worldfile import load_world
+
+    problems = []
+    local = exercise.folder / exercise.world
+    names = [local if local.suffix in (".yaml", ".yml") and local.exists() else exercise.world]
+    names += sorted(exercise.folder.glob("worlds/*.yaml"))
+    for name in names:
+        try:
+            load_world(name)
+        except ContentError as exc:
+            if name == exercise.world and not exc.path.exists():
+                # No such world: the mistake is in the exercise file's `world` field.
+                doc = load_document(exercise.folder / "exercise.yaml")
+                exc = doc.error(exc.message, "world")
+            problems.append(_from(exc))
+    return problems
+
+
+def _gradings(exercise: Exercise, grade: Callable[..., RunResult]) -> list[Problem]:
+    where = exercise.folder / "exercise.yaml"
+    problems = []
+    reference = grade(exercise, exercise.solution)
+    if reference.grader_error:
+        last = (reference.grader_details.strip().splitlines() or [reference.grader_error])[-1]
+        problems.append(Problem(where, None, _(
+            "grading the reference solution failed: {details}").format(details=last)))
+    elif reference.score != reference.max_score:
+        failed = ", ".join(t.name for t in reference.tests if not t.passed)
+        problems.append(Problem(where, None, _(
+            "the reference solution scores {score}/{max_score}, not full marks (failed: "
+            "{failed})").format(score=number(reference.score),
+                                max_score=number(reference.max_score), failed=failed)))
+    starter = grade(exercise, exercise.starter)
+    if starter.grader_error is None and starter.passed:
+        problems.append(Problem(where, None, _(
+            "the starter scores {score}/{max_score}, at or above the pass mark").format(
+            score=number(starter.score), max_score=number(starter.max_score))))
+    return problems
+
+
+def validate(root: Path | None = None, *, run_gradings: bool = True, jobs: int = 2,
+             progress: Callable[[str], None] | None = None) -> list[Problem]:
+    """Every problem in the course tree (``root`` defaults to the course in use)."""
+    from autograder.grading import grade
+    from autograder.quiz.lint import lint
+
+    folder = root / "assignments" if root else assignments_dir()
+    problems: list[Problem] = []
+    exercises = []
+    for path in sorted(p for p in folder.iterdir() if p.is_dir()) if folder.is_dir() else []:
+        if not (path / "exercise.yaml").exists():
+            problems.append(Problem(path, None, _("no exercise.yaml in this folder")))
+            continue
+        try:
+            exercise = load_exercise(path)
+        except ContentError as exc:
+            problems.append(_from(exc))
+            continue
+        found = _files(exercise) + _worlds(exercise)
+        problems += found
+        if not found:
+            exercises.append(exercise)
+    if run_gradings:
+        def check(exercise: Exercise) -> list[Problem]:
+            if progress:
+                progress(exercise.id)
+            return _gradings(exercise, grade)
+
+        with ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
+            for found in pool.map(check, exercises):
+                problems += found
+    problems += lint(root, root / "locales" if root else None)
+    return problems

@@ -1,0 +1,93 @@
+"""Bad authoring input gets an error naming the file and what is wrong; `autograder
+validate` checks a whole course tree."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from autograder.cli import main
+from autograder.exercise import load_exercise
+from autograder.grading import GRADER_FAULT, grade
+from autograder.validate import validate
+
+MINI = Path(__file__).parent / "fixtures" / "mini_course"
+
+
+@pytest.fixture
+def course(tmp_path: Path, monkeypatch) -> Path:
+    root = tmp_path / "course"
+    shutil.copytree(MINI, root)
+    monkeypatch.setenv("AUTOGRADER_COURSE", str(root))
+    return root
+
+
+def shout(course: Path) -> Path:
+    return course / "assignments" / "shout"
+
+
+@pytest.mark.slow
+def test_a_sound_course_validates(course):
+    assert [str(p) for p in validate(course)] == []
+    result = CliRunner().invoke(main, ["validate", "--no-grade", "--course", str(course)])
+    assert result.exit_code == 0 and "The course is valid." in result.output
+
+
+def test_missing_files_and_bad_worlds_are_named(course):
+    (shout(course) / "starter" / "shouter.py").unlink()
+    other = course / "assignments" / "broken"
+    shutil.copytree(shout(course), other)
+    text = (other / "exercise.yaml").read_text().replace("id: shout", "id: broken")
+    (other / "exercise.yaml").write_text(text + "world: no_such_world\n")
+    third = course / "assignments" / "typo"
+    shutil.copytree(shout(course), third)
+    (third / "exercise.yaml").write_text("id: typo\ntitle: T\nfile: a.py\nnode: a\n"
+                                         "pass_mark: 0.7\nponits: 3\n")
+    (course / "assignments" / "empty").mkdir()
+    problems = [str(p) for p in validate(course, run_gradings=False)]
+    assert any("shout/exercise.yaml" in p and "starter file" in p for p in problems)
+    assert any(p.startswith(f"{other / 'exercise.yaml'}:") and "world: unknown world "
+               "'no_such_world'" in p for p in problems), problems
+    assert any(p.startswith(f"{third / 'exercise.yaml'}:6: ponits: unknown field")
+               for p in problems), problems
+    assert any(f"{course / 'assignments' / 'empty'}:1: no exercise.yaml" in p for p in problems)
+    result = CliRunner().invoke(main, ["validate", "--no-grade", "--course", str(course)])
+    assert result.exit_code == 1 and "problems found" in result.output
+
+
+@pytest.mark.slow
+def test_a_failing_reference_and_a_passing_starter_are_caught(course):
+    folder = shout(course)
+    solution = (folder / "solution" / "shouter.py").read_text()
+    (folder / "solution" / "shouter.py").write_text(solution.replace("msg.data.upper()",
+                                                                     "msg.data"))
+    (folder / "starter" / "shouter.py").write_text(solution)
+    problems = [str(p) for p in validate(course)]
+    assert any("the reference solution scores 2/3" in p for p in problems), problems
+    assert any("the starter scores 3/3, at or above the pass mark" in p for p in problems)
+
+
+def test_malformed_exercise_file_names_file_line_and_field(course):
+    (shout(course) / "exercise.yaml").write_text("id: shout\ntitle: [unclosed\n")
+    with pytest.raises(Exception) as caught:
+        load_exercise(shout(course))
+    assert str(caught.value).startswith(f"{shout(course) / 'exercise.yaml'}:")
+    result = CliRunner().invoke(main, ["check", "shout", str(course)])
+    assert result.exit_code == 2 and "exercise.yaml:" in result.output
+    assert "Traceback" not in result.output
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("broken,where", [
+    ("def test_x(:\n    pass\n", "test_broken.py"),                      # does not import
+    ("def test_x(student):\n    {}['missing']\n", "test_broken.py"),     # raises inside
+])
+def test_a_broken_exercise_test_is_a_grader_error_naming_the_file(course, broken, where):
+    (shout(course) / "tests" / "public" / "test_broken.py").write_text(broken)
+    exercise = load_exercise(shout(course))
+    result = grade(exercise, None)
+    assert result.grader_error == GRADER_FAULT
+    assert where in result.grader_details
