@@ -12,4 +12,4 @@ sys.path.insert(0, str(Path(__file__).parent))
 @pytest.fixture(scope="module")
 def commands(probe):
     """Everything published on cmd_vel in this module, stamped with simulation time."""
-    return probe.subscribe(Twist, "/cmd_vel")
+    return probe.subscribe(Twist, "/cmd_vel", stamp="published")

@@ -20,6 +20,8 @@ RANGE_MIN, RANGE_MAX = 0.12, 3.5
 FORWARD, TURN = 0.2, 0.5
 # A command published at a tick can be stamped by the probe one tick (0.1 s) late.
 LATE = 0.15
+# No cmd_vel for this long (three cycles and a tick) means the node no longer runs.
+SILENT = 0.35
 
 
 def bearing(beam: int) -> float:
@@ -96,15 +98,22 @@ def describe(t: Twist) -> str:
     return f"linear.x={t.linear.x:.3g}, angular.z={t.angular.z:.3g}"
 
 
-def alive(node: Any, when: str) -> None:
-    """Fail with the node's last words if its process has ended."""
-    if node.running():
-        return
-    raise StudentFailure(
-        _("The node's process ended {when} (exit status {code}). Its last lines:\n{tail}")
-        .format(when=when, code=node.returncode, tail=node.output_tail(12)),
-        _("Catch exceptions inside your callbacks: log them with get_logger().error(...), "
-          "publish a stop and carry on."))
+def alive(probe: Any, inbox: Any, node: Any, when: str) -> None:
+    """Fail with the node's last words if its process ended or it stopped publishing."""
+    if not node.running():
+        raise StudentFailure(
+            _("The node's process ended {when} (exit status {code}). Its last lines:\n{tail}")
+            .format(when=when, code=node.returncode, tail=node.output_tail(12)),
+            _("Catch exceptions inside your callbacks: log them with get_logger().error(...), "
+              "publish a stop and carry on."))
+    stamps = inbox.times
+    if not stamps or stamps[-1] < probe.now - SILENT:
+        raise StudentFailure(
+            _("The node stopped publishing on cmd_vel {when}, though its process still runs "
+              "(did an exception end the thread that spins?). Its last lines:\n{tail}")
+            .format(when=when, tail=node.output_tail(12)),
+            _("Catch exceptions inside your callbacks: log them with get_logger().error(...), "
+              "publish a stop and carry on."))
 
 
 def wait_command(probe: Any, inbox: Any, since: float, wanted: Callable[[Twist], bool],
@@ -124,7 +133,7 @@ def settle_forward(probe: Any, inbox: Any, feeder: ScanFeeder, node: Any) -> flo
     """Feed a clear view until the node drives forward; the simulation time it did."""
     since = feeder.feed(CLEAR)
     if wait_command(probe, inbox, since, is_forward, 2.0) is None:
-        alive(node, _("while it was shown a clear way ahead"))
+        alive(probe, inbox, node, _("while it was shown a clear way ahead"))
         last = inbox.messages[-1:] or None
         raise StudentFailure(
             _("With nothing nearer than 2 m, cmd_vel never said linear.x={v}, angular.z=0 "

@@ -44,6 +44,10 @@ SCHEDULE = (
 STOP_WITHIN = 0.5 + 0.1 + 0.1 + LATE
 STILL_LINEAR, STILL_ANGULAR = 0.01, 0.02
 MOVE_WITHIN = 1.0
+# A gap in cmd_vel longer than this (five cycles) means the control loop stopped ...
+GAP = 0.5
+# ... and one this long ends the run: nothing more can be judged.
+GONE = 1.0
 
 
 @dataclasses.dataclass
@@ -81,9 +85,14 @@ def run(world, probe, student, commands) -> Run:
     marks = sorted([(d.start, d, "wall_start") for d in dropouts] +
                    [(d.end, d, "wall_end") for d in dropouts], key=lambda m: m[0])
     died_at = None
+
+    def gone() -> bool:  # the process ended, or it runs but publishes nothing any more
+        stamps = commands.times
+        return not student.running() or not stamps or stamps[-1] < probe.now - GONE
+
     for when, dropout, field in [*marks, (t0 + RUN, None, "")]:
-        probe.wait_for(lambda w=when: probe.now >= w or not student.running(), when - probe.now)
-        if not student.running():
+        probe.wait_for(lambda w=when: probe.now >= w or gone(), when - probe.now)
+        if gone():
             died_at = probe.now
             break
         if dropout is not None:
@@ -93,26 +102,36 @@ def run(world, probe, student, commands) -> Run:
 
 
 def _died(run: Run, student) -> None:
-    if run.died_at is not None:
-        raise StudentFailure(
-            _("The node's process ended {seconds:.1f} s into the run (exit status {code}), "
-              "so the rest could not be judged. Its last lines:\n{tail}").format(
-                seconds=run.died_at - run.start, code=student.returncode,
-                tail=student.output_tail(12)),
-            _("Catch exceptions in your callbacks and ignore invalid readings; the public "
-              "tests show which scans hurt."))
+    if run.died_at is None:
+        return
+    if student.returncode is not None:
+        message = _("The node's process ended {seconds:.1f} s into the run (exit status "
+                    "{code}), so the rest could not be judged. Its last lines:\n{tail}")
+    else:
+        message = _("The node stopped publishing on cmd_vel {seconds:.1f} s into the run, "
+                    "though its process still ran (did an exception end the thread that "
+                    "spins?), so the rest could not be judged. Its last lines:\n{tail}")
+    raise StudentFailure(
+        message.format(seconds=run.died_at - run.start, code=student.returncode,
+                       tail=student.output_tail(12)),
+        _("Catch exceptions in your callbacks and ignore invalid readings; the public "
+          "tests show which scans hurt."))
 
 
 @pytest.mark.points(2)
 def test_stays_alive(run, student):
     """Through 60 s of faulty scans the node stays alive and keeps publishing"""
     _died(run, student)
-    recent = window(run.commands, run.end - 0.5, run.end + 0.3)
-    if not recent:
+    stamps = [t for t in run.commands.times if run.start <= t <= run.end] + [run.end]
+    gaps = [(b - a, a) for a, b in zip([run.start, *stamps], stamps, strict=False)]
+    gap, since = max(gaps)
+    if gap > GAP:
         raise StudentFailure(
-            _("The node was running at the end of the run but had not published on cmd_vel "
-              "for the last 0.5 s of simulation time."),
-            _("Keep the 10 Hz timer publishing, whatever the scans look like."))
+            _("The node published nothing on cmd_vel for {gap:.1f} s of simulation time from "
+              "{since:.1f} s into the run, though its process still ran (did an exception end "
+              "the thread that spins?).").format(gap=gap, since=since - run.start),
+            _("Keep the 10 Hz timer publishing whatever the scans look like; catch "
+              "exceptions inside callbacks."))
 
 
 @pytest.mark.points(2)

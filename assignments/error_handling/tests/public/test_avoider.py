@@ -12,6 +12,7 @@ from helpers import (
     CLEAR,
     FORWARD,
     LATE,
+    SILENT,
     TURN,
     ScanFeeder,
     alive,
@@ -44,7 +45,13 @@ def feeder(world, probe):
 @pytest.fixture
 def avoider(feeder, student, start_node, probe, commands):
     """The module's node, or a fresh one if an earlier test killed it."""
-    node = student if student.running() else start_node()
+    feeder.feed(CLEAR)  # whatever an earlier test left on /scan, a new node starts sane
+    node = student
+    if node.running() and not probe.wait_for(
+            lambda: bool(commands.times) and commands.times[-1] >= probe.now - SILENT, 1.0):
+        node.stop()  # running but silent: an exception ended the thread that spins it
+    if not node.running():
+        node = start_node()
     if not probe.wait_for_subscriber(LaserScan, "/scan", 5.0):
         raise StudentFailure(
             _("Nothing subscribes to scan."),
@@ -127,7 +134,7 @@ def test_rejects_malformed_scans(avoider, feeder, probe, commands):
         probe.wait_sim(0.6)
         stop = wait_command(probe, commands, since, is_zero, 0.1)
         going = [m for m in window(commands, since + 0.2 + LATE, probe.now) if not is_zero(m)]
-        alive(avoider, _("after it was sent {what}").format(what=what))
+        alive(probe, commands, avoider, _("after it was sent {what}").format(what=what))
         if stop is None or going:
             raise StudentFailure(
                 _("After {what}, cmd_vel said {got}; expected a zero Twist for that "
@@ -161,7 +168,7 @@ def test_ignores_invalid_readings(avoider, feeder, probe, commands):
     settle_forward(probe, commands, feeder, avoider)
     since = feeder.feed(make_scan(_invalid))
     probe.wait_sim(1.0)
-    alive(avoider, _("after a scan with NaN and ±inf readings"))
+    alive(probe, commands, avoider, _("after a scan with NaN and ±inf readings"))
     wrong = [m for m in window(commands, since + LATE, probe.now) if not is_forward(m)]
     if wrong:
         raise StudentFailure(
@@ -171,7 +178,7 @@ def test_ignores_invalid_readings(avoider, feeder, probe, commands):
             _("Skip a reading unless range_min <= r <= range_max (false for NaN and inf)."))
     since = feeder.feed(make_scan(_hidden_obstacle))
     turned = wait_command(probe, commands, since, lambda m: turn_of(m) != 0, 1.0)
-    alive(avoider, _("after a scan with NaN readings"))
+    alive(probe, commands, avoider, _("after a scan with NaN readings"))
     if turned is None:
         raise StudentFailure(
             _("An obstacle 0.45 m ahead, between NaN readings, did not make the robot turn "
@@ -188,7 +195,7 @@ def test_survives_exceptions(avoider, feeder, probe, commands):
         settle_forward(probe, commands, feeder, avoider)
         since = feeder.feed(bad)
         probe.wait_sim(0.6)
-        alive(avoider, _("after a scan with {what}").format(what=what))
+        alive(probe, commands, avoider, _("after a scan with {what}").format(what=what))
         stop = wait_command(probe, commands, since, is_zero, 0.1)
         going = [m for m in window(commands, since + 0.2 + LATE, probe.now) if not is_zero(m)]
         if stop is None or going:
@@ -198,4 +205,4 @@ def test_survives_exceptions(avoider, feeder, probe, commands):
                 _("Wrap the work of each callback in try/except Exception: log the error "
                   "with get_logger().error(...) and publish Twist()."))
     settle_forward(probe, commands, feeder, avoider)
-    alive(avoider, _("after the scans it could not use"))
+    alive(probe, commands, avoider, _("after the scans it could not use"))
