@@ -339,6 +339,7 @@ def world(request: pytest.FixtureRequest, exercise: Any, ros_context: Any) -> It
     spec = load_world(local if local.suffix in (".yaml", ".yml") and local.exists() else name)
     rtf = request.config.getoption("real_time_factor")
     bridge = SimBridge(World(spec), ros_context, max_clock_hz=exercise.clock_hz,
+                       cpu_budget=exercise.cpu_budget,
                        real_time_factor=exercise.real_time_factor if rtf is None else rtf)
     bridge.start()
     try:
