@@ -1,0 +1,179 @@
+"""The timer_sync run and what is measured on it, in simulation time.
+
+The world holds each clock tick until the student's process is quiescent, but under load
+the probe may receive a message a tick or two late; so the streams are stamped with the
+sim time they were *published* at (the tick in force when the student sent them, from
+the DDS source timestamp).  A healthy 10 Hz timer then shows gaps of 0.1 s; a node one
+tick slow to react shows 0.15 s (RTF 1) and still keeps its beat; 0.2 s is a lost beat.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from typing import Any
+
+from autograder.errors import StudentFailure
+from autograder.i18n import _
+
+CONTROL_HZ = 10.0
+STATUS_PERIOD = 1.0
+PLAN_PERIOD = 10.0
+PLAN_SECONDS = 2.0
+# The run: sim seconds at the exercise's pace (RTF 1), then at OTHER_RTF, where a node
+# timed by the wall clock runs at twice its rates in sim time.  Not RTF 2: its ticks
+# are 0.1 s of sim time, one control period, so a node one tick slow to react loses a
+# beat (measured: the chapter's design lost one in six runs beside another grading).
+FIRST_SECONDS = 24.0
+OTHER_SECONDS = 6.0
+OTHER_RTF = 0.5
+# Discovery may cost the first messages: the window opens this long after the first one.
+SETTLE = 0.5
+# cmd_vel silent this long (sim s): the node froze, stop watching.
+FROZEN = 3.0
+MAX_GAP = 0.15 + 1e-6
+RATE_TOLERANCE = 0.03
+
+
+@dataclass
+class Streams:
+    commands: Any
+    statuses: Any
+    plans: Any
+
+
+@dataclass
+class Run:
+    """What was seen in the window [start, end); the pace changed at ``switch``."""
+
+    start: float | None
+    switch: float | None
+    end: float
+    commands: list[tuple[float, Any]]
+    statuses: list[tuple[float, Any]]
+    plans: list[tuple[float, Any]]
+    frozen_at: float | None = None
+
+    def command_times(self, a: float | None = None, b: float | None = None) -> list[float]:
+        a = self.start if a is None else a
+        b = self.end if b is None else b
+        return [t for t, _m in self.commands if a <= t < b]
+
+    def status_items(self) -> list[tuple[float, Any]]:
+        return [(t, m) for t, m in self.statuses if self.start <= t < self.end]
+
+    def plan_times(self) -> list[float]:
+        return [t for t, _m in self.plans if self.start <= t < self.end]
+
+
+def _watch(probe, streams: Streams, seconds: float, wall_factor: float) -> float | None:
+    """Let ``seconds`` of sim time pass; the time cmd_vel froze at, if it went silent."""
+    end = probe.now + seconds
+    while probe.now < end:
+        times = streams.commands.times
+        last = times[-1] if times else probe.now
+        if probe.now - last > FROZEN:
+            return last
+        chunk = min(1.0, end - probe.now)
+        target = probe.now + chunk
+        probe.wait_for(lambda t=target: probe.now >= t, chunk + 0.5,
+                       wall_timeout=max(10.0, wall_factor * 4 * chunk))
+    return None
+
+
+def _change_pace(probe, world, rtf: float) -> float:
+    """Set the pace at a sim time that is a multiple of the control period, so that the
+    new ticks fall on the control timer's beats (the predicate runs between ticks)."""
+    period = 1.0 / CONTROL_HZ
+    switched: list[float] = []
+
+    def on_a_beat() -> bool:
+        if not switched and abs(math.remainder(probe.now, period)) < 1e-6:
+            world.set_real_time_factor(rtf)
+            switched.append(probe.now)
+        return bool(switched)
+
+    probe.wait_for(on_a_beat, 1.0)
+    if not switched:  # no tick on a beat (another pace): switch now, a gap may read 0.15
+        world.set_real_time_factor(rtf)
+        switched.append(probe.now)
+    return switched[0]
+
+
+def observe(probe, world, streams: Streams) -> Run:
+    """Watch the node for FIRST_SECONDS at the world's pace, then OTHER_SECONDS at OTHER_RTF."""
+    commands = streams.commands
+    if not probe.wait_for(lambda: len(commands) > 0, 5.0):
+        return Run(None, None, probe.now, [], streams.statuses.items, streams.plans.items)
+    start = commands.times[0] + SETTLE
+    probe.wait_for(lambda: probe.now >= start, SETTLE + 1.0)
+    frozen = _watch(probe, streams, FIRST_SECONDS, 1.0)
+    switch = None
+    if frozen is None:
+        pace = world.real_time_factor
+        switch = _change_pace(probe, world, OTHER_RTF)
+        try:
+            frozen = _watch(probe, streams, OTHER_SECONDS, 1.0 / OTHER_RTF)
+        finally:
+            world.set_real_time_factor(pace)
+    end = probe.now if frozen is None else frozen + FROZEN
+    return Run(start, switch, end, commands.items, streams.statuses.items,
+               streams.plans.items, frozen)
+
+
+# -- checks --------------------------------------------------------------------------
+
+def require_commands(run: Run) -> None:
+    if run.start is None:
+        raise StudentFailure(
+            _("Nothing came on cmd_vel within 5 s of simulation time."),
+            _("Create a 10 Hz timer whose callback publishes a Twist on cmd_vel."))
+
+
+def require_not_frozen(run: Run, what: str) -> None:
+    if run.frozen_at is not None:
+        raise StudentFailure(
+            _("cmd_vel stopped at t={t:.2f} s of simulation time ({after:.1f} s into the run) "
+              "and never came back, so {what} could not be measured.").format(
+                t=run.frozen_at, after=run.frozen_at - run.start, what=what),
+            freeze_hint())
+
+
+def freeze_hint() -> str:
+    return _("The planner blocks for 2 s of ROS time. In a single-threaded executor that "
+             "also blocks the /clock subscription which advances ROS time, so time itself "
+             "stops. Spin a MultiThreadedExecutor and give the planner timer a callback "
+             "group of its own.")
+
+
+def gaps(times: list[float], start: float, end: float) -> list[tuple[float, float]]:
+    """(gap, where) for each interval between messages, the window's edges included."""
+    points = [start, *times, end]
+    return [(b - a, a) for a, b in zip(points, points[1:], strict=False)]
+
+
+def biggest_gap(times: list[float], start: float, end: float) -> tuple[float, float]:
+    return max(gaps(times, start, end), default=(0.0, start))
+
+
+def rate_ok(count: int, seconds: float, hz: float) -> bool:
+    expected = seconds * hz
+    return abs(count - expected) <= max(1.0, RATE_TOLERANCE * expected)
+
+
+def parse_status(message: Any) -> dict[str, int] | None:
+    """The status's fields, or None if it is not a JSON object with two integer counts."""
+    try:
+        data = json.loads(message.data)
+    except ValueError:
+        return None
+    if not isinstance(data, dict):
+        return None
+    fields = {}
+    for key in ("control_ticks", "plans"):
+        value = data.get(key)
+        if not isinstance(value, int) or isinstance(value, bool):
+            return None
+        fields[key] = value
+    return fields

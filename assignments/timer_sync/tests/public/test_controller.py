@@ -1,0 +1,201 @@
+"""Public tests: a 10 Hz control loop, 1 Hz status and 0.1 Hz plans, all in simulation time.
+
+One run per module: 24 s of simulation time at real-time pace, then 6 s at half that.
+"""
+
+import pytest
+from helpers import (
+    CONTROL_HZ,
+    MAX_GAP,
+    PLAN_PERIOD,
+    PLAN_SECONDS,
+    STATUS_PERIOD,
+    biggest_gap,
+    freeze_hint,
+    parse_status,
+    rate_ok,
+    require_commands,
+    require_not_frozen,
+)
+
+from autograder.errors import StudentFailure
+from autograder.i18n import _
+
+CRUISE = 0.2
+
+
+@pytest.mark.points(1)
+def test_node_starts(student, probe, streams):
+    """The node starts as multi_rate_controller and publishes cmd_vel at cruise_speed 0.2"""
+    commands = streams.commands
+    if not probe.wait_for(lambda: len(commands) >= 3, 5.0):
+        raise StudentFailure(
+            _("Nothing came on cmd_vel within 5 s of simulation time."),
+            _("Create a 10 Hz timer whose callback publishes a Twist on cmd_vel."))
+    wrong = [m.linear.x for m in commands.messages if abs(m.linear.x - CRUISE) > 1e-6]
+    if wrong:
+        raise StudentFailure(
+            _("cmd_vel had linear.x={got}; expected the cruise_speed parameter's default, "
+              "{cruise}.").format(got=wrong[0], cruise=CRUISE),
+            _("Declare cruise_speed with default 0.2 and publish its value as linear.x."))
+
+
+@pytest.mark.points(3)
+def test_control_rate(run):
+    """cmd_vel keeps 10 Hz for 30 s of simulation time, with no gap over 0.15 s"""
+    require_commands(run)
+    times = run.command_times()
+    seconds = run.end - run.start
+    gap, where = biggest_gap(times, run.start, run.end)
+    if run.frozen_at is not None:
+        raise StudentFailure(
+            _("cmd_vel stopped at t={t:.2f} s of simulation time, {after:.1f} s into the run, "
+              "and never came back.").format(t=run.frozen_at, after=run.frozen_at - run.start),
+            freeze_hint())
+    if not rate_ok(len(times), seconds, CONTROL_HZ):
+        raise StudentFailure(
+            _("cmd_vel came {count} times in {seconds:.1f} s of simulation time "
+              "({rate:.2f} Hz); expected 10 Hz.").format(
+                count=len(times), seconds=seconds, rate=len(times) / seconds),
+            _("Create the control timer with a period of 0.1 s on the node's clock "
+              "(self.create_timer), which follows simulation time."))
+    if gap > MAX_GAP:
+        raise StudentFailure(
+            _("cmd_vel went silent for {gap:.2f} s at t={t:.2f} s of simulation time; no gap "
+              "may exceed 0.15 s.").format(gap=gap, t=where),
+            _("Something blocked the control timer. Is a slow callback sharing its callback "
+              "group or the executor's only thread?"))
+
+
+@pytest.mark.points(2)
+def test_control_while_planning(run):
+    """cmd_vel keeps 10 Hz while the planner runs"""
+    require_commands(run)
+    plans = run.plan_times()
+    if run.frozen_at is not None:
+        raise StudentFailure(
+            _("cmd_vel stopped at t={t:.2f} s of simulation time and never came back{plans}.")
+            .format(t=run.frozen_at, plans=_(", and no plan was published") if not plans
+                    else ""),
+            freeze_hint())
+    # Each plan message ends a planner run that began PLAN_SECONDS before it.
+    for done in plans:
+        began = max(run.start, done - PLAN_SECONDS)
+        times = run.command_times(began, done)
+        gap, where = biggest_gap(times, began, done)
+        if gap > MAX_GAP or not rate_ok(len(times), done - began, CONTROL_HZ):
+            raise StudentFailure(
+                _("While the planner ran (t={a:.2f} to {b:.2f} s of simulation time), cmd_vel "
+                  "came {count} times, with a gap of {gap:.2f} s at t={t:.2f}; expected 10 Hz "
+                  "throughout.").format(a=began, b=done, count=len(times), gap=gap, t=where),
+                _("Give the planner timer its own callback group and spin a "
+                  "MultiThreadedExecutor, so control runs in another thread meanwhile."))
+
+
+@pytest.mark.points(1)
+def test_status_rate(run):
+    """status comes at 1 Hz as a JSON object with integer control_ticks and plans"""
+    require_commands(run)
+    items = run.status_items()
+    seconds = run.end - run.start
+    if not items:
+        raise StudentFailure(
+            _("Nothing came on status in {seconds:.1f} s of simulation time.").format(
+                seconds=seconds),
+            _("Create a 1 s timer that publishes a std_msgs/String on status."))
+    bad = [m.data for _t, m in items if parse_status(m) is None]
+    if bad:
+        raise StudentFailure(
+            _("A status message was {text!r}; expected a JSON object with integer "
+              "control_ticks and plans, e.g. {{\"control_ticks\": 120, \"plans\": 1}}.")
+            .format(text=bad[0][:200]),
+            _("Build a dict and publish json.dumps(it) as the String's data."))
+    require_not_frozen(run, _("the status rate"))
+    times = [t for t, _m in items]
+    gap, where = biggest_gap(times, run.start, run.end)
+    if not rate_ok(len(items), seconds, 1.0 / STATUS_PERIOD) or gap > STATUS_PERIOD + 0.1 + 1e-6:
+        raise StudentFailure(
+            _("status came {count} times in {seconds:.1f} s of simulation time, with a gap of "
+              "{gap:.2f} s at t={t:.2f}; expected 1 Hz.").format(
+                count=len(items), seconds=seconds, gap=gap, t=where),
+            _("Create the status timer with a period of 1.0 s on the node's clock."))
+
+
+@pytest.mark.points(2)
+def test_status_counts(run):
+    """status's control_ticks and plans agree with what the node published"""
+    require_commands(run)
+    command_times = [t for t, _m in run.commands]
+    plan_times = [t for t, _m in run.plans]
+    items = [(t, parse_status(m)) for t, m in run.status_items()]
+    items = [(t, s) for t, s in items if s is not None]
+    if len(items) < 3:
+        raise StudentFailure(
+            _("Only {count} valid status messages came; at least 3 are needed to compare "
+              "counts.").format(count=len(items)),
+            _("Publish status every second as JSON with control_ticks and plans."))
+    # control_ticks counts from the node's start; the probe may have missed the first
+    # few, so what must hold is a constant difference (one message either side: stamps).
+    offsets = [s["control_ticks"] - sum(1 for c in command_times if c <= t) for t, s in items]
+    low, high = min(offsets), max(offsets)
+    if high - low > 2 or low < -2:
+        worst = max(range(len(items)), key=lambda i: abs(offsets[i] - offsets[0]))
+        t, s = items[worst]
+        raise StudentFailure(
+            _("At t={t:.2f} s status said control_ticks={ticks}, but cmd_vel had come {seen} "
+              "times by then; control_ticks must count every control callback since the "
+              "node started.").format(t=t, ticks=s["control_ticks"],
+                                      seen=sum(1 for c in command_times if c <= t)),
+            _("Increment one counter in the control callback and report it as is; do not "
+              "reset it."))
+    for t, s in items:
+        if any(abs(t - p) <= 0.2 for p in plan_times):
+            continue  # a status beside a plan may count it or not yet
+        seen = sum(1 for p in plan_times if p <= t)
+        if s["plans"] != seen:
+            raise StudentFailure(
+                _("At t={t:.2f} s status said plans={plans}, but {seen} plans had been "
+                  "published by then.").format(t=t, plans=s["plans"], seen=seen),
+                _("Count a plan when the planner finishes one and report the count."))
+
+
+@pytest.mark.points(2)
+def test_plan_rate(run):
+    """A plan is published every 10 s of simulation time"""
+    require_commands(run)
+    plans = run.plan_times()
+    seconds = run.end - run.start
+    if len(plans) < 2:
+        raise StudentFailure(
+            _("{count} plans came in {seconds:.1f} s of simulation time; expected one every "
+              "10 s.").format(count=len(plans), seconds=seconds),
+            freeze_hint() if run.frozen_at is not None else
+            _("Create a 10 s timer that calls plan_route() and publishes the result on plan."))
+    intervals = [b - a for a, b in zip(plans, plans[1:], strict=False)]
+    wrong = [d for d in intervals if abs(d - PLAN_PERIOD) > 0.25]
+    if wrong or len(plans) > seconds / PLAN_PERIOD + 1:
+        raise StudentFailure(
+            _("Plans came {count} times in {seconds:.1f} s of simulation time, {apart} s "
+              "apart; expected every 10 s.").format(
+                count=len(plans), seconds=seconds,
+                apart=", ".join(f"{d:.2f}" for d in intervals)),
+            _("Create the planner timer with a period of 10.0 s on the node's clock."))
+
+
+@pytest.mark.points(2)
+def test_rates_at_half_speed(run):
+    """Rates hold in simulation time when the world runs at half speed"""
+    require_commands(run)
+    require_not_frozen(run, _("the rates at half speed"))
+    seconds = run.end - run.switch
+    commands = run.command_times(run.switch, run.end)
+    statuses = [t for t, _m in run.status_items() if t >= run.switch]
+    if not rate_ok(len(commands), seconds, CONTROL_HZ) or \
+            not rate_ok(len(statuses), seconds, 1.0 / STATUS_PERIOD):
+        raise StudentFailure(
+            _("With the world at half speed, cmd_vel came at {control:.1f} Hz and status at "
+              "{status:.1f} Hz in simulation time; expected 10 Hz and 1 Hz.").format(
+                control=len(commands) / seconds, status=len(statuses) / seconds),
+            _("Time everything with the node's timers (self.create_timer) and clock "
+              "(self.get_clock()), never time.sleep or time.time: with use_sim_time they "
+              "follow /clock, whatever its pace."))
