@@ -37,6 +37,7 @@ class Isolation:
 
     strict: bool
     reason: str = ""
+    detail: str = ""
 
     @property
     def mode(self) -> str:
@@ -44,7 +45,8 @@ class Isolation:
 
     def to_dict(self) -> dict[str, object]:
         return {"mode": self.mode, "separate_user": self.strict, "network": not self.strict,
-                "hidden_files_protected": self.strict, "reason": self.reason}
+                "hidden_files_protected": self.strict, "reason": self.reason,
+                "detail": self.detail}
 
 
 def student_uid(domain: int) -> int:
@@ -71,8 +73,8 @@ def detect() -> Isolation:
     if probe.returncode != 0:
         detail = (probe.stderr or probe.stdout).strip().splitlines()
         return Isolation(False, N_("an unprivileged user cannot run this Python and rclpy "
-                                   "(make the virtual environment readable by all)")
-                         + (f": {detail[-1]}" if detail else ""))
+                                   "(make the virtual environment readable by all)"),
+                         detail[-1] if detail else "")
     return Isolation(True)
 
 

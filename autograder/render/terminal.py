@@ -43,6 +43,10 @@ def to_terminal(result: RunResult, color: bool = False, show_details: bool = Tru
                         .format(score=number(result.score), max_score=number(result.max_score),
                                 percent=percent, verdict=verdict, mark=mark),
                         "green" if result.passed else "red", color, bold=True))
+    isolation = result.data.get("isolation", {})
+    if isolation.get("mode") == "basic":
+        lines.append(_("Isolation: basic, {reason}; the program ran as the grader's user.")
+                     .format(reason=_(isolation.get("reason", ""))))
     if result.grader_error:
         lines.append(_style(_("The autograder failed, tell your instructor."), "yellow", color,
                             bold=True))
