@@ -568,7 +568,7 @@ def _wait_for_node(exercise: Any, node: StudentNode, world: Any) -> None:
           "(nodes seen: {others}).\nLast lines of its output:\n{tail}").format(
             node=exercise.node, seconds=exercise.startup_timeout,
             others=", ".join(others) or _("none"), tail=tail or _("(no output)")),
-        _("Create the node with super().__init__('{node}') and spin it.").format(
+        _("Create the node with `super().__init__('{node}')` and spin it.").format(
             node=exercise.node))
 
 
@@ -587,7 +587,7 @@ def student(request: pytest.FixtureRequest, exercise: Any, submission_file: Path
               "until it is stopped.\nLast lines of its output:\n{tail}").format(
                 how=_describe_exit(code if code is not None else 0),
                 tail=node.output_tail() or _("(no output)")),
-            _("Call rclpy.spin(node) (or an executor's spin) after creating the node."))
+            _("Call `rclpy.spin(node)` (or an executor's `spin()`) after creating the node."))
     try:
         yield node
     finally:

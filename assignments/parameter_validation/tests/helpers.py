@@ -25,11 +25,11 @@ def ready(probe, inbox) -> None:
     if not probe.wait_for_subscriber(Twist, "agent/cmd_vel", 5.0):
         raise StudentFailure(
             _("Nothing subscribes to agent/cmd_vel."),
-            _("Create a subscription: self.create_subscription(Twist, 'agent/cmd_vel', ...)."))
+            _("Create a subscription: `self.create_subscription(Twist, 'agent/cmd_vel', ...)`."))
     if not probe.wait_for(lambda: inbox.publisher_count() > 0, 5.0):
         raise StudentFailure(
             _("Nothing publishes on cmd_vel."),
-            _("Create a publisher: self.create_publisher(Twist, 'cmd_vel', 10)."))
+            _("Create a publisher: `self.create_publisher(Twist, 'cmd_vel', 10)`."))
 
 
 def exchange(probe, inbox, wish: Twist) -> list[Twist]:

@@ -25,13 +25,13 @@ def refused(probe, name, value):
         raise StudentFailure(
             _("Setting {name} to {value!r} was accepted; it must be refused.").format(
                 name=name, value=value),
-            _("Return SetParametersResult(successful=False, reason=...) from an on-set "
+            _("Return `SetParametersResult(successful=False, reason=...)` from an on-set "
               "parameters callback."))
     if not result.reason.strip():
         raise StudentFailure(
             _("Setting {name} to {value!r} was refused with an empty reason.").format(
                 name=name, value=value),
-            _("Say why in SetParametersResult.reason, naming the parameter."))
+            _("Say why in `SetParametersResult.reason`, naming the parameter."))
     kept = probe.get_parameters(NODE, [name])[name]
     if kept != DEFAULTS[name]:
         raise StudentFailure(

@@ -26,10 +26,10 @@ def test_invalid_override_exits(start_node):
             raise StudentFailure(
                 _("Started with -p {name}:={value}, the node exited with status 0; a refusal "
                   "must exit non-zero.").format(name=name, value=value),
-                _("Return 1 from main() and call sys.exit(main())."))
+                _("Return 1 from `main()` and call `sys.exit(main())`."))
         if name not in node.output():
             raise StudentFailure(
                 _("Started with -p {name}:={value}, the node exited but its log does not name "
                   "{name}. Its last lines:\n{tail}").format(
                     name=name, value=value, tail=node.output_tail(8)),
-                _("Log the problem with self.get_logger().error(...), naming the parameter."))
+                _("Log the problem with `self.get_logger().error(...)`, naming the parameter."))

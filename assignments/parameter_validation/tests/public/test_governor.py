@@ -24,7 +24,7 @@ def test_clamps_linear(student, probe, commands):
                 _("The agent asked for linear.x={asked}; cmd_vel had linear.x={got}, "
                   "expected {expected} (max_linear_speed is 0.5).").format(
                     asked=asked, got=got, expected=expected),
-                _("Clamp with max(-limit, min(limit, value))."))
+                _("Clamp with `max(-limit, min(limit, value))`."))
 
 
 @pytest.mark.points(1)
@@ -68,4 +68,4 @@ def test_other_fields_zero(student, probe, commands):
         raise StudentFailure(
             _("cmd_vel passed on fields the robot cannot follow: {fields}.").format(
                 fields=", ".join(f"{k}={v}" for k, v in wrong.items())),
-            _("Build a fresh Twist() and set only linear.x and angular.z."))
+            _("Build a fresh `Twist()` and set only `linear.x` and `angular.z`."))
