@@ -20,8 +20,8 @@ RANGE_MIN, RANGE_MAX = 0.12, 3.5
 FORWARD, TURN = 0.2, 0.5
 # A command published at a tick can be stamped by the probe one tick (0.1 s) late.
 LATE = 0.15
-# No cmd_vel for this long (three cycles and a tick) means the node no longer runs.
-SILENT = 0.35
+# No cmd_vel for this long (five cycles) means the node no longer runs.
+SILENT = 0.5
 
 
 def bearing(beam: int) -> float:

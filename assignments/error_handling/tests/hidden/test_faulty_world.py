@@ -44,10 +44,10 @@ SCHEDULE = (
 STOP_WITHIN = 0.5 + 0.1 + 0.1 + LATE
 STILL_LINEAR, STILL_ANGULAR = 0.01, 0.02
 MOVE_WITHIN = 1.0
-# A gap in cmd_vel longer than this (five cycles) means the control loop stopped ...
-GAP = 0.5
+# A gap in cmd_vel longer than this (ten cycles) means the control loop stopped ...
+GAP = 1.0
 # ... and one this long ends the run: nothing more can be judged.
-GONE = 1.0
+GONE = 2.0
 
 
 @dataclasses.dataclass
@@ -170,7 +170,7 @@ def test_stops_during_dropout(run, world, student):
                          if first else describe(going[0]))),
                 _("A watchdog: remember when the last scan came and publish Twist() on every "
                   "cycle once it is more than 0.5 s old (in ROS time)."))
-        if len(sent) < cycles - 3:
+        if len(sent) < cycles / 2:  # every cycle, less what a busy machine may cost
             raise StudentFailure(
                 _("While the lidar was silent ({seconds:.1f} s into the run) cmd_vel was "
                   "published {count} times in {span:.1f} s; a stop is due on every 10 Hz "

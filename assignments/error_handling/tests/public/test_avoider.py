@@ -67,7 +67,7 @@ def test_publishes_at_10_hz(avoider, feeder, probe, commands):
     start = probe.now
     probe.wait_sim(3.0)
     count = len(window(commands, start, start + 3.0))
-    if not 27 <= count <= 33:
+    if not 24 <= count <= 36:  # 10 Hz, give or take cycles a busy machine may cost
         raise StudentFailure(
             _("In 3 s of simulation time cmd_vel was published {count} times; a 10 Hz timer "
               "gives 30.").format(count=count),
@@ -131,7 +131,7 @@ def test_rejects_malformed_scans(avoider, feeder, probe, commands):
                       (make_scan(count=180), _("a scan of 180 ranges whose angles say 360"))):
         settle_forward(probe, commands, feeder, avoider)
         since = feeder.feed(bad)
-        probe.wait_sim(0.6)
+        probe.wait_sim(1.0)
         stop = wait_command(probe, commands, since, is_zero, 0.1)
         going = [m for m in window(commands, since + 0.2 + LATE, probe.now) if not is_zero(m)]
         alive(probe, commands, avoider, _("after it was sent {what}").format(what=what))
@@ -194,7 +194,7 @@ def test_survives_exceptions(avoider, feeder, probe, commands):
                       (make_scan(angle_increment=math.nan), _("angle_increment NaN"))):
         settle_forward(probe, commands, feeder, avoider)
         since = feeder.feed(bad)
-        probe.wait_sim(0.6)
+        probe.wait_sim(1.0)
         alive(probe, commands, avoider, _("after a scan with {what}").format(what=what))
         stop = wait_command(probe, commands, since, is_zero, 0.1)
         going = [m for m in window(commands, since + 0.2 + LATE, probe.now) if not is_zero(m)]
