@@ -16,3 +16,14 @@ def ros_domain() -> Iterator[int]:
     os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
     with reserve_domain() as domain:
         yield domain
+
+
+def pytest_generate_tests(metafunc: pytest.Metafunc) -> None:
+    """Parametrize the standard proof checks (tests/proving.py) from the module's PROOF."""
+    proof = getattr(metafunc.module, "PROOF", None)
+    if proof is None:
+        return
+    if "correct" in metafunc.fixturenames:
+        metafunc.parametrize("correct", list(proof.correct))
+    if "mutant" in metafunc.fixturenames:
+        metafunc.parametrize("mutant", list(proof.mutants))
