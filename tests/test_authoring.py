@@ -91,3 +91,16 @@ def test_a_broken_exercise_test_is_a_grader_error_naming_the_file(course, broken
     result = grade(exercise, None)
     assert result.grader_error == GRADER_FAULT
     assert where in result.grader_details
+
+
+@pytest.mark.slow
+def test_check_runs_public_tests_only_without_a_grader_fault(course, tmp_path):
+    """The public tests carry fewer points than the exercise: that is no fault."""
+    out = tmp_path / "results.json"
+    result = CliRunner().invoke(main, ["check", "shout", str(shout(course) / "solution"),
+                                       "--results", str(out)])
+    assert result.exit_code == 0, result.output
+    data = __import__("json").loads(out.read_text())
+    assert data["grader_error"] is None
+    assert (data["score"], data["max_score"]) == (2, 2)
+    assert {t["visibility"] for t in data["tests"]} == {"visible"}
