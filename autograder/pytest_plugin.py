@@ -58,6 +58,8 @@ def pytest_configure(config: pytest.Config) -> None:
         "hidden for tests under a hidden/ folder)")
     config.addinivalue_line("markers", "world(name): the world this module's tests run in")
     config.addinivalue_line(
+        "markers", "parameters(dict): -p overrides the module's `student` node starts with")
+    config.addinivalue_line(
         "markers", "reveal(what): what a student sees of a failure: 'message' or 'status' "
         "(default: 'message' for visible tests, 'status' for hidden ones)")
     if config.getoption("exercise", None):
@@ -575,8 +577,11 @@ def _wait_for_node(exercise: Any, node: StudentNode, world: Any) -> None:
 @pytest.fixture(scope="module")
 def student(request: pytest.FixtureRequest, exercise: Any, submission_file: Path,
             probe: Any, world: Any) -> Iterator[StudentNode]:
-    """The student's node, started once for this module with its default parameters."""
-    node = launch(request, exercise, submission_file, probe, world)
+    """The student's node, started once for this module with its default parameters (or
+    those of the module's ``@pytest.mark.parameters({...})``)."""
+    marker = request.node.get_closest_marker("parameters")
+    node = launch(request, exercise, submission_file, probe, world,
+                  marker.args[0] if marker and marker.args else None)
     # A program that creates its node and quits at once must fail the same way every time,
     # whether or not we saw the node in between: watch it for a moment of sim time.
     if probe.wait_for(lambda: not node.running(), STARTUP_SETTLE):
