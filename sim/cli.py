@@ -65,8 +65,12 @@ def check_command(file: Path) -> None:
 @click.option("--svg", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="Write a picture of the trajectory here.")
 @click.option("--seed", type=int, default=None, help="Override the world's seed.")
+@click.option("--clock-hz", type=click.FloatRange(min=1.0), default=20.0, show_default=True,
+              help="Most /clock messages per wall second (as graded: Jazzy's "
+                   "MultiThreadedExecutor stutters from about 50 Hz).")
 def run_command(world_name: str, rtf: float, duration: float | None, domain: int | None,
-                record: Path | None, svg: Path | None, seed: int | None) -> None:
+                record: Path | None, svg: Path | None, seed: int | None,
+                clock_hz: float) -> None:
     """Run a world on a ROS domain so a node started by hand can drive the robot.
 
     Start your node in another terminal with the same ROS_DOMAIN_ID and
@@ -75,13 +79,13 @@ def run_command(world_name: str, rtf: float, duration: float | None, domain: int
     spec = _load(world_name)
     domain = int(os.environ.get("ROS_DOMAIN_ID", "0")) if domain is None else domain
     summary = run_world(spec, rtf=rtf, duration=duration, domain=domain, seed=seed,
-                        record=record, svg=svg)
+                        record=record, svg=svg, clock_hz=clock_hz)
     click.echo(summary)
 
 
 def run_world(spec, *, rtf: float, duration: float | None, domain: int,  # noqa: ANN001
               seed: int | None = None, record: Path | None = None,
-              svg: Path | None = None) -> str:
+              svg: Path | None = None, clock_hz: float = 20.0) -> str:
     """Run ``spec`` on ``domain`` until ``duration`` sim seconds or Ctrl-C; return a summary."""
     import rclpy
     from rclpy.context import Context
@@ -92,7 +96,7 @@ def run_world(spec, *, rtf: float, duration: float | None, domain: int,  # noqa:
 
     ctx = Context()
     rclpy.init(context=ctx, domain_id=domain)
-    bridge = SimBridge(World(spec, seed=seed), ctx, real_time_factor=rtf)
+    bridge = SimBridge(World(spec, seed=seed), ctx, real_time_factor=rtf, max_clock_hz=clock_hz)
     click.echo(_("World {name} on ROS domain {domain}, RTF {rtf}. Ctrl-C stops.").format(
         name=spec.name, domain=domain, rtf=rtf or _("max")))
     bridge.start()
