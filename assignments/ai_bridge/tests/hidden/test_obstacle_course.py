@@ -1,0 +1,25 @@
+"""Hidden tests: corner to corner across a room, with obstacles on the straight line."""
+
+import pytest
+from helpers import judge_efficiency, judge_reached
+
+from autograder.i18n import _
+from sim.worldfile import load_world
+
+WORLD = "obstacle_course"
+GOAL = load_world(WORLD).goal
+LIMIT = 60.0
+pytestmark = [pytest.mark.world(WORLD),
+              pytest.mark.parameters({"goal_x": GOAL.x, "goal_y": GOAL.y})]
+
+
+@pytest.mark.points(3)
+def test_obstacles_reaches_goal(mission, credit):
+    """Obstacle course: the robot stops within 0.3 m of the goal, touching nothing"""
+    judge_reached(mission, credit, _("obstacle course"))
+
+
+@pytest.mark.points(1)
+def test_obstacles_efficient_path(mission, credit):
+    """Obstacle course: the path is not much longer than the straight line (bonus)"""
+    judge_efficiency(mission, credit, _("obstacle course"))

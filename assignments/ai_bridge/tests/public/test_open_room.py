@@ -1,0 +1,50 @@
+"""Public tests: in an open room, the agent turns, drives to its goal, stops and says so."""
+
+import pytest
+from helpers import REACHED, STATUS_WITHIN, judge_efficiency, judge_reached
+
+from autograder.errors import StudentFailure
+from autograder.i18n import _
+from sim.worldfile import load_world
+
+WORLD = "open_room"
+GOAL = load_world(WORLD).goal
+LIMIT = 40.0  # simulation seconds to arrive
+pytestmark = [pytest.mark.world(WORLD),
+              pytest.mark.parameters({"goal_x": GOAL.x, "goal_y": GOAL.y})]
+
+
+@pytest.mark.points(3)
+def test_open_room_reaches_goal(mission, credit):
+    """Open room: the robot stops within 0.3 m of the goal, touching nothing"""
+    judge_reached(mission, credit, _("open room"))
+
+
+@pytest.mark.points(2)
+def test_open_room_reports_arrival(mission):
+    """On arrival the agent publishes on agent_status, and not before"""
+    if mission.arrived_at is None:
+        raise StudentFailure(
+            _("The robot never stopped at the goal, so its report could not be judged."),
+            _("Reach the goal first (see the test above)."))
+    if not mission.statuses:
+        raise StudentFailure(
+            _("The robot stopped {left:.2f} m from the goal, and nothing came on agent_status "
+              "within {within:.0f} s.").format(
+                left=mission.to_goal(mission.samples[-1]), within=STATUS_WITHIN),
+            _("Publish a std_msgs/String such as 'goal reached' on agent_status once, when "
+              "you stop at the goal."))
+    stamp, text = mission.statuses[0]
+    pose = mission.pose_at(stamp)
+    away = mission.to_goal(pose) if pose else mission.distance
+    if away > REACHED + 0.05:
+        raise StudentFailure(
+            _("agent_status said {text!r} while the robot was still {away:.2f} m from the "
+              "goal.").format(text=text, away=away),
+            _("Report arrival when you are within 0.3 m of the goal, not before."))
+
+
+@pytest.mark.points(1)
+def test_open_room_efficient_path(mission, credit):
+    """Open room: the path is not much longer than the straight line (bonus)"""
+    judge_efficiency(mission, credit, _("open room"))
