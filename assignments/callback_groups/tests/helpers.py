@@ -1,0 +1,193 @@
+"""Shared steps of the callback_groups tests: ask check_path, judge the answer.
+
+Requests go out through the probe's node with ``call_async`` and are not waited for one
+by one, so several can be in flight at once; each answer is stamped with the sim time
+the probe received it (at most a tick late, well inside the 1 s allowed).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import threading
+import time
+from dataclasses import dataclass
+from typing import Any
+
+import pytest
+from std_srvs.srv import Trigger
+
+from autograder.errors import StudentFailure
+from autograder.i18n import _
+
+SERVICE = "check_path"
+SECTOR = math.radians(30.0)
+CLEARANCE = 0.5
+ANSWER_WITHIN = 1.0      # sim seconds a request may take (the spec's wait, at most)
+DISTANCE_TOLERANCE = 0.03
+RATE_LOW, RATE_HIGH = 8.0, 12.0   # scans_per_second: 10, +-1 at the second's edges
+NUMBER = re.compile(r"-?\d+(?:\.\d+)?")
+
+
+@dataclass
+class Answer:
+    sent: float
+    answered: float | None = None
+    response: Any = None
+
+    @property
+    def latency(self) -> float | None:
+        return None if self.answered is None else self.answered - self.sent
+
+
+def nearest_ahead(scan: Any) -> float | None:
+    """The smallest valid reading within +-30 degrees of straight ahead (None: none)."""
+    best = None
+    for i, r in enumerate(scan.ranges):
+        angle = scan.angle_min + i * scan.angle_increment
+        angle = math.atan2(math.sin(angle), math.cos(angle))
+        if math.isfinite(r) and scan.range_min <= r <= scan.range_max and \
+                abs(angle) <= SECTOR + 1e-9 and (best is None or r < best):
+            best = r
+    return best
+
+
+def numbers(text: str) -> list[float]:
+    return [float(n) for n in NUMBER.findall(text)]
+
+
+class Requests:
+    """check_path requests in flight from the probe's node."""
+
+    def __init__(self, probe: Any) -> None:
+        self.probe = probe
+        self.client = probe.node.create_client(Trigger, SERVICE)
+        self.answers: list[Answer] = []
+        self._lock = threading.Lock()
+
+    def ready(self, sim_timeout: float = 5.0) -> bool:
+        return self.probe.wait_for(self.client.service_is_ready, sim_timeout)
+
+    def send(self) -> Answer:
+        answer = Answer(sent=self.probe.now)
+        future = self.client.call_async(Trigger.Request())
+
+        def done(f: Any, a: Answer = answer) -> None:
+            try:
+                response = None if f.cancelled() else f.result()
+            except Exception:  # noqa: BLE001 - a failed call is an answer that says nothing
+                response = None
+            with self._lock:
+                a.answered = self.probe.now
+                a.response = response
+
+        future.add_done_callback(done)
+        self.answers.append(answer)
+        return answer
+
+    def answered(self, answers: list[Answer]) -> bool:
+        with self._lock:
+            return all(a.answered is not None for a in answers)
+
+    def wait(self, answers: list[Answer], sim_timeout: float) -> bool:
+        return self.probe.wait_for(lambda: self.answered(answers), sim_timeout)
+
+    def close(self) -> None:
+        self.probe.node.destroy_client(self.client)
+
+
+def require_service(requests: Requests) -> None:
+    if not requests.ready():
+        raise StudentFailure(
+            _("No check_path service appeared within 5 s of simulation time."),
+            _("Create it with self.create_service(Trigger, 'check_path', callback)."))
+
+
+def ask(probe: Any, sim_timeout: float = 3.0) -> Answer:
+    """One request, waited for; fails the test when no answer comes."""
+    requests = Requests(probe)
+    try:
+        require_service(requests)
+        answer = requests.send()
+        if not requests.wait([answer], sim_timeout):
+            raise StudentFailure(
+                _("check_path did not answer within {seconds:.0f} s of simulation time.")
+                .format(seconds=sim_timeout), deadlock_hint())
+        return answer
+    finally:
+        requests.close()
+
+
+def require_alive(alive: bool) -> None:
+    if not alive:
+        pytest.skip(_("Not run: the node neither published scans_per_second nor answered "
+                      "check_path, so its callbacks never run. Is it spinning, with an "
+                      "executor that honours callback groups?"))
+
+
+def deadlock_hint() -> str:
+    return _("A callback that waits blocks its callback group, and in a single-threaded "
+             "executor the whole node, /clock included: the scan it waits for can never "
+             "arrive. Put the service and the scan subscription in different callback "
+             "groups and spin a MultiThreadedExecutor (not Jazzy's experimental "
+             "EventsExecutor, which ignores callback groups).")
+
+
+def first_scan_after(scans: Any, stamp: float) -> Any:
+    for t, scan in scans.items:
+        if t > stamp + 1e-9:
+            return scan
+    return None
+
+
+def scan_after(probe: Any, scans: Any, stamp: float) -> Any:
+    """The first scan published after ``stamp``, waited for (an answer may come first)."""
+    probe.wait_for(lambda: first_scan_after(scans, stamp) is not None, 1.0)
+    return first_scan_after(scans, stamp)
+
+
+def judge(answer: Answer, scan: Any, where: str) -> None:
+    """The answer must match ``scan``: its success flag and nearest distance."""
+    expected = nearest_ahead(scan) if scan is not None else None
+    clear = expected is None or expected >= CLEARANCE
+    response = answer.response
+    if response is None:
+        raise StudentFailure(_("check_path failed to answer {where}.").format(where=where))
+    if scan is not None and answer.latency is not None and answer.latency >= 0.9:
+        raise StudentFailure(
+            _("{where}, check_path answered after {latency:.2f} s of simulation time "
+              "({message!r}), though a scan came every 0.1 s.").format(
+                where=where, latency=answer.latency, message=response.message),
+            deadlock_hint())
+    if response.success != clear:
+        raise StudentFailure(
+            _("{where}, check_path answered success={got} ({message!r}), but the nearest "
+              "valid reading within 30 degrees of straight ahead was {nearest:.2f} m, so "
+              "success must be {want}.").format(
+                where=where, got=response.success, message=response.message,
+                nearest=expected if expected is not None else float("inf"), want=clear),
+            _("Use only readings that are finite and within [range_min, range_max], at "
+              "angles within +-30 degrees of straight ahead (wrap angle_min + i * "
+              "angle_increment into [-pi, pi]); success means all of them are at least "
+              "0.5 m."))
+    if expected is not None and not any(abs(n - expected) <= DISTANCE_TOLERANCE
+                                        for n in numbers(response.message)):
+        raise StudentFailure(
+            _("{where}, check_path's message was {message!r}; it must give the nearest "
+              "distance ahead, {nearest:.2f} m.").format(
+                where=where, message=response.message, nearest=expected),
+            _("Put the distance in the message, e.g. f'nearest obstacle ahead: "
+              "{{nearest:.2f}} m'.").format())
+
+
+def rate_reports(rates: Any, start: float, end: float) -> list[float]:
+    return [m.data for t, m in rates.items if start <= t <= end]
+
+
+def wait_student_idle(student: Any, wall_timeout: float) -> None:
+    """Wait (wall time: the world is paused) until the student's process has no work."""
+    from sim.bridge import process_state
+
+    end = time.monotonic() + wall_timeout
+    while time.monotonic() < end and process_state(student.process.pid)[0]:
+        time.sleep(0.002)

@@ -1,0 +1,164 @@
+"""Hidden tests: invalid readings, concurrent requests, a scan newer than the request, no
+scan at all, and a node still alive at the end."""
+
+import pytest
+from helpers import (
+    ANSWER_WITHIN,
+    RATE_HIGH,
+    RATE_LOW,
+    Requests,
+    ask,
+    deadlock_hint,
+    judge,
+    rate_reports,
+    require_alive,
+    require_service,
+    scan_after,
+    wait_student_idle,
+)
+
+from autograder.errors import StudentFailure
+from autograder.i18n import _
+from sim.worldfile import Box, Fault
+
+BOX_AHEAD = Box(center=(3.45, 3.0), size=(0.1, 0.6))
+CONCURRENT = 5
+# With the world paused, how long (wall) an answer from an old scan is waited for.
+PAUSED_WALL = 0.5
+
+
+@pytest.mark.points(1)
+def test_ignores_invalid_readings(student, probe, scans, world, alive):
+    """Invalid readings (NaN, inf, below range_min) do not block the path"""
+    require_alive(alive)
+    start = probe.now
+    for kind in ("nan", "inf", "neg_inf", "below_min"):
+        world.inject(Fault(kind=kind, start=start, end=start + 2.0, fraction=0.15))
+    try:
+        probe.wait_sim(0.3)
+        answer = ask(probe)
+        judge(answer, scan_after(probe, scans, answer.sent),
+              _("With 15% of the beams each NaN, +inf, -inf and below range_min"))
+    finally:  # the next test starts with clean scans, whatever happened here
+        probe.wait_for(lambda: probe.now > start + 2.0, 3.0)
+
+
+@pytest.mark.points(2)
+def test_concurrent_requests(student, probe, scans, rates, alive):
+    """Five requests at once are all answered within 1.0 s, and scans keep being counted"""
+    require_alive(alive)
+    requests = Requests(probe)
+    try:
+        require_service(requests)
+        start = probe.now
+        answers = [requests.send() for _ in range(CONCURRENT)]
+        requests.wait(answers, 3.0)
+        late = [a for a in answers if a.latency is None or a.latency > ANSWER_WITHIN]
+        if late:
+            got = sum(1 for a in answers if a.answered is not None)
+            raise StudentFailure(
+                _("Of {n} requests sent together, {got} were answered and {late} took more "
+                  "than 1.0 s of simulation time (or never came).").format(
+                    n=CONCURRENT, got=got, late=len(late)),
+                _("While one request waits for its scan, the others must not wait for it: a "
+                  "ReentrantCallbackGroup for the service (and enough executor threads), or "
+                  "requests served one after another, each within 0.1 s."))
+        for answer in answers:
+            judge(answer, scan_after(probe, scans, answer.sent),
+                  _("Among five requests sent together"))
+        probe.wait_for(lambda: probe.now > start + 2.5, 4.0)
+        reports = rate_reports(rates, start + 0.5, start + 2.5)
+        if len(reports) < 2 or not all(RATE_LOW <= v <= RATE_HIGH for v in reports):
+            raise StudentFailure(
+                _("While requests were served, scans_per_second read {values}; expected "
+                  "about 10 every second.").format(
+                    values=", ".join(f"{v:g}" for v in reports) or _("nothing")),
+                _("A waiting request must not hold up the scan callback or the rate timer: "
+                  "give the service a callback group of its own."))
+    finally:
+        requests.close()
+
+
+@pytest.mark.points(1)
+def test_no_fresh_scan(student, probe, world, alive):
+    """Without a scan for 3 s, check_path answers success=false after waiting 1.0 s"""
+    require_alive(alive)
+    start = probe.now
+    world.inject(Fault(kind="dropout", start=start, end=start + 3.0))
+    try:
+        probe.wait_sim(0.3)
+        answer = ask(probe)
+    finally:  # scans flow again before the next test
+        probe.wait_for(lambda: probe.now > start + 3.3, 4.0)
+    response = answer.response
+    if response is None or response.success:
+        raise StudentFailure(
+            _("With no scan coming, check_path answered success={got} ({message!r}); the "
+              "path cannot be confirmed clear, so success must be false.").format(
+                got=getattr(response, "success", None),
+                message=getattr(response, "message", "")),
+            _("Answer only from a scan that arrives after the request; when none comes "
+              "within 1.0 s, say so with success=False."))
+    # 1.0 s of ROS time is asked for; a wall-clock wait of 1.0 s is let pass (sim time
+    # may run slower than the wall on a busy machine), an answer without waiting is not.
+    if not 0.5 <= answer.latency <= 1.5:
+        raise StudentFailure(
+            _("With no scan coming, check_path answered after {latency:.2f} s of simulation "
+              "time; it must wait 1.0 s of ROS time for a scan first.").format(
+                latency=answer.latency),
+            _("Measure the wait with self.get_clock().now(), which follows /clock."))
+
+
+@pytest.mark.points(2)
+def test_answer_uses_newer_scan(student, probe, scans, world, alive):
+    """The answer comes from a scan newer than the request (a box appears just before it)"""
+    require_alive(alive)
+    requests = Requests(probe)
+    try:
+        require_service(requests)
+        probe.wait_sim(0.2)
+        world.pause()
+        try:
+            # Every scan the node had is now handled; the box is in the next one only.
+            wait_student_idle(student, 2.0)
+            world.inject(Fault(kind="obstacle", start=world.now, box=BOX_AHEAD))
+            answer = requests.send()
+            world.wait_for(lambda: requests.answered([answer]), float("inf"), PAUSED_WALL)
+            early = answer.answered is not None
+        finally:
+            world.resume()
+        if early:
+            raise StudentFailure(
+                _("check_path answered ({message!r}) before any scan newer than the request "
+                  "existed: the world was paused, and a box had just appeared ahead.").format(
+                    message=getattr(answer.response, "message", "")),
+                _("Wait in the service callback until the scan callback delivers a scan "
+                  "that arrived after the request (a counter or a threading.Event set by "
+                  "the scan callback), then answer from that one."))
+        if not requests.wait([answer], 3.0):
+            raise StudentFailure(
+                _("check_path did not answer within 3 s of simulation time."), deadlock_hint())
+        judge(answer, scan_after(probe, scans, answer.sent),
+              _("With a box appearing 0.40 m ahead just before the request"))
+    finally:
+        requests.close()
+
+
+@pytest.mark.points(1)
+def test_never_deadlocks(student, probe, rates, alive):
+    """After all that, the node still counts scans and answers"""
+    require_alive(alive)
+    start = probe.now
+    probe.wait_for(lambda: probe.now > start + 2.2, 3.0)
+    reports = rate_reports(rates, start + 0.1, start + 2.2)
+    if len(reports) < 2 or not all(RATE_LOW <= v <= RATE_HIGH for v in reports):
+        raise StudentFailure(
+            _("At the end, scans_per_second read {values} in 2 s of simulation time; expected "
+              "about 10 every second.").format(
+                values=", ".join(f"{v:g}" for v in reports) or _("nothing")),
+            deadlock_hint())
+    answer = ask(probe)
+    if answer.latency > ANSWER_WITHIN:
+        raise StudentFailure(
+            _("At the end, check_path took {latency:.2f} s of simulation time.").format(
+                latency=answer.latency), deadlock_hint())
