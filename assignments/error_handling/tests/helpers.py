@@ -45,11 +45,11 @@ def make_scan(reading: Callable[[float], float] | float = 2.0, *, count: int = B
 
 
 def blocked(toward: int) -> LaserScan:
-    """An obstacle 0.4 m ahead; open on the side ``toward`` (+1 left, -1 right), near on the
-    other, so every sensible measure of room agrees."""
+    """An obstacle 0.4 to 0.55 m ahead; open on the side ``toward`` (+1 left, -1 right), near
+    on the other, so every sensible measure of room (mean, minimum, count) agrees."""
     def reading(b: float) -> float:
         if abs(b) <= 35:
-            return 0.4
+            return 0.55 if b * toward > 0 else 0.4
         return 3.0 if b * toward > 0 else 0.5
     return make_scan(reading)
 

@@ -96,7 +96,7 @@ def test_turns_toward_room(avoider, feeder, probe, commands):
         turned = wait_command(probe, commands, since, lambda m: not is_forward(m), 1.0)
         if turned is None or turn_of(turned) != toward:
             raise StudentFailure(
-                _("An obstacle 0.4 m ahead, open space on the {side}: cmd_vel said {got}; "
+                _("An obstacle 0.4 to 0.55 m ahead, open space on the {side}: cmd_vel said {got}; "
                   "expected linear.x=0, angular.z={z}.").format(
                     side=side, got=describe(turned) if turned else _("nothing new"),
                     z=toward * TURN),
