@@ -9,7 +9,7 @@ MultiThreadedExecutor so both can run; guard state shared between threads with a
 Prerequisites: subscriptions, services (std_srvs/Trigger) and timers in one Node.
 
 Expected output: `check_path` facing open floor answers success=True, "nearest
-obstacle ahead: 2.98 m"; with a box 0.4 m ahead, success=False, "nearest obstacle
+obstacle ahead: 2.97 m"; with a box 0.4 m ahead, success=False, "nearest obstacle
 ahead: 0.40 m". scans_per_second reads 10.0 every second, also while requests wait.
 """
 import math

@@ -68,7 +68,7 @@ def test_open_space(student, probe, scans, alive):
     require_alive(alive)
     answer = ask(probe)
     judge(answer, scan_after(probe, scans, answer.sent),
-          _("With 2.98 m of open floor ahead and two pillars close by on the sides"))
+          _("With 2.97 m of open floor ahead and two pillars close by on the sides"))
     if answer.latency > ANSWER_WITHIN:
         raise StudentFailure(
             _("check_path took {latency:.2f} s of simulation time; a scan comes every "

@@ -88,7 +88,8 @@ class SafetySupervisor(Node):
 def main(args=None):
     rclpy.init(args=args)
     node = SafetySupervisor()
-    executor = MultiThreadedExecutor()
+    # One thread per group: requests, sensor, default (/clock).
+    executor = MultiThreadedExecutor(num_threads=3)
     executor.add_node(node)
     try:
         executor.spin()
