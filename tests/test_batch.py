@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import csv
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -126,10 +127,17 @@ def test_shards_partition_and_merge(tmp_path, submissions, one_by_one, course_en
     shares = [[s for s in students if in_shard(s, (i, 3))] for i in (1, 2, 3)]
     assert sorted(sum(shares, [])) == students
     assert all(in_shard(s, (1, 1)) for s in students)
+    # Half the class is enough to see shards split and merge (and costs half the gradings).
+    half = tmp_path / "half"
+    half.mkdir()
+    for entry in sorted(submissions.iterdir())[:6]:
+        (shutil.copytree if entry.is_dir() else shutil.copy)(entry, half / entry.name)
+    shares = [[s for s in share if (half / s).exists() or (half / f"{s}.py").exists()]
+              for share in shares]
     books = []
     for i in (1, 2):  # two shards of three are enough to see the merge
         book = tmp_path / f"shard{i}.csv"
-        proc = batch(["shout", str(submissions), "--jobs", "2", "--csv", str(book),
+        proc = batch(["shout", str(half), "--jobs", "2", "--csv", str(book),
                       "--out", str(tmp_path / f"out{i}"), "--shard", f"{i}/3"], course_env)
         output, _ = proc.communicate(timeout=600)
         assert proc.returncode == 0, output

@@ -17,7 +17,7 @@ from autograder.grading import grade
 pytestmark = pytest.mark.slow
 
 COURSE = Path(__file__).parent / "fixtures" / "mini_course"
-RUNS = 8
+RUNS = 6
 
 
 @pytest.fixture
