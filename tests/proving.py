@@ -31,6 +31,7 @@ class Proof:
     mutants: dict[str, frozenset[str]] = dataclasses.field(default_factory=dict)
     broken: tuple[str, ...] = ()
     repeats: int = 5
+    jobs: int = JOBS
 
     def grade_all(self) -> dict[str, RunResult]:
         exercise = find_exercise(self.exercise)
@@ -39,7 +40,7 @@ class Proof:
         jobs["starter"] = exercise.starter
         for name in [*self.correct, *self.mutants, *self.broken]:
             jobs[name] = folder / name
-        with ThreadPoolExecutor(max_workers=JOBS) as pool:
+        with ThreadPoolExecutor(max_workers=self.jobs) as pool:
             futures = {name: pool.submit(grade, exercise, path) for name, path in jobs.items()}
             return {name: future.result() for name, future in futures.items()}
 
