@@ -34,6 +34,26 @@ def _copy(source: Path, dest: Path) -> None:
 def _copy_platform(root: Path, out: Path) -> None:
     for name in PLATFORM:
         _copy(root / name, out / name)
+    for catalog in sorted((out / "locales").rglob("*.po*")):
+        _drop_hidden_entries(catalog)
+
+
+def _drop_hidden_entries(path: Path) -> None:
+    """Remove the messages only hidden tests use (their feedback is not for students)."""
+    from babel.messages.pofile import read_po, write_po
+
+    with path.open("rb") as fh:
+        catalog = read_po(fh)
+    def hidden(location: tuple[str, int | None]) -> bool:
+        return "/tests/hidden/" in f"/{location[0]}"
+
+    for message in list(catalog):
+        if message.id and message.locations and all(map(hidden, message.locations)):
+            catalog.delete(message.id, message.context)
+        elif message.id:  # shared with public tests: keep it, not the hidden file's name
+            message.locations = [loc for loc in message.locations if not hidden(loc)]
+    with path.open("wb") as fh:
+        write_po(fh, catalog, width=88, sort_by_file=True)
 
 
 def student_files(exercise: Exercise) -> list[Path]:

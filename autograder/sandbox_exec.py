@@ -68,12 +68,48 @@ def private_mounts() -> None:
     _mount("none", "/", None, MS_REC | MS_PRIVATE, None)
 
 
+# What a student's program may see of the machine: the system, and what it runs on.
+SYSTEM = ("/usr", "/bin", "/sbin", "/lib", "/lib32", "/lib64", "/libx32", "/etc", "/proc",
+          "/sys", "/dev", "/tmp")
+
+
+def _cover(path: str) -> None:
+    """Cover ``path`` with an empty, read-only filesystem nobody but root can enter."""
+    _mount("tmpfs", path, "tmpfs", MS_RDONLY | MS_NOSUID | MS_NODEV | MS_NOEXEC,
+           "size=4k,mode=000")
+
+
 def hide(paths: list[str]) -> None:
-    """Cover each path with an empty, read-only filesystem nobody but root can enter."""
     for path in paths:
         if os.path.isdir(path):
-            _mount("tmpfs", path, "tmpfs", MS_RDONLY | MS_NOSUID | MS_NODEV | MS_NOEXEC,
-                   "size=4k,mode=000")
+            _cover(path)
+
+
+def hide_all_but(needed: list[str]) -> None:
+    """Cover every folder that is neither system nor on the way to a ``needed`` path, so no
+    copy of a course anywhere on the machine (a checkout, a clone in /tmp) is in reach."""
+    needed = [os.path.realpath(p) for p in needed]
+
+    def walk(folder: str) -> None:
+        try:
+            entries = sorted(os.scandir(folder), key=lambda e: e.name)
+        except OSError:
+            return
+        for entry in entries:
+            path = entry.path
+            if not entry.is_dir(follow_symlinks=False) or path in SYSTEM:
+                continue
+            if any(n == path for n in needed):
+                continue  # needed whole
+            if any(n.startswith(path + os.sep) for n in needed):
+                walk(path)  # on the way to something needed: look inside
+            else:
+                try:
+                    _cover(path)
+                except OSError:
+                    pass  # a special mount we may not cover; permissions still apply
+
+    walk("/")
 
 
 def fill_workdir(workdir: str, size_mb: int, uid: int) -> None:
@@ -115,6 +151,8 @@ def main(argv: list[str]) -> None:
     if uid is not None:
         private_mounts()
         hide(spec.get("hide", []))
+        hide_all_but([sys.prefix, sys.base_prefix, sys.exec_prefix,
+                      os.path.dirname(os.path.realpath(sys.executable)), spec["workdir"]])
         fill_workdir(spec["workdir"], int(spec.get("workdir_mb", 64)), uid)
     for cgroup in spec.get("cgroups", []):
         with open(os.path.join(cgroup, "cgroup.procs"), "w") as fh:

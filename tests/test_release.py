@@ -18,26 +18,25 @@ from autograder.release import build_gradescope_bundle, build_release, student_f
 ROOT = Path(__file__).resolve().parent.parent
 
 
-def hidden_test_names() -> set[str]:
+def hidden_test_names(exercise) -> set[str]:
     names = set()
-    for exercise in list_exercises():
-        for path in exercise.hidden_tests.rglob("*.py"):
-            tree = ast.parse(path.read_text())
-            names |= {node.name for node in ast.walk(tree)
-                      if isinstance(node, ast.FunctionDef) and node.name.startswith("test_")}
+    for path in exercise.hidden_tests.rglob("*.py"):
+        tree = ast.parse(path.read_text())
+        names |= {node.name for node in ast.walk(tree)
+                  if isinstance(node, ast.FunctionDef) and node.name.startswith("test_")}
     return names
 
 
-def solution_lines() -> set[str]:
-    """Lines of the reference solutions that the starters do not share."""
+def solution_lines(exercise) -> set[str]:
+    """Lines of the reference solution that nothing a student is meant to have shows (the
+    starter, the READMEs, which may teach a pattern on purpose, the public tests)."""
+    published = "".join(p.read_text(errors="replace") for p in student_files(exercise))
     lines = set()
-    for exercise in list_exercises():
-        starter = {line.strip() for line in exercise.starter.read_text().splitlines()}
-        for path in exercise.solution.parent.rglob("*.py"):
-            for line in path.read_text().splitlines():
-                line = line.strip()
-                if len(line) >= 24 and line not in starter and not line.startswith("#"):
-                    lines.add(line)
+    for path in exercise.solution.parent.rglob("*.py"):
+        for line in path.read_text().splitlines():
+            line = line.strip()
+            if len(line) >= 24 and line not in published and not line.startswith("#"):
+                lines.add(line)
     return lines
 
 
@@ -59,16 +58,18 @@ def test_release_has_what_students_need(release):
 
 
 def test_release_leaks_no_hidden_test_solution_or_key(release):
-    names, lines = hidden_test_names(), solution_lines()
-    assert names and lines  # the check has something to look for
     assert not list(release.rglob("solution")) and not list(release.rglob("hidden"))
     assert not list(release.glob("quizzes/*.yaml"))  # quiz files hold the answer key
+    catalogs = "".join(p.read_text() for p in (release / "locales").rglob("*.po*"))
+    assert "/tests/hidden/" not in catalogs  # hidden tests' feedback is not shipped
     leaks = []
-    for path in release.rglob("*"):
-        if path.is_file():
-            text = path.read_text(errors="replace")
-            leaks += [(path, n) for n in names if n in text]
-            leaks += [(path, line) for line in lines if line in text]
+    for exercise in list_exercises():
+        names, lines = hidden_test_names(exercise), solution_lines(exercise)
+        assert names and lines  # the check has something to look for
+        for path in (release / "assignments" / exercise.id).rglob("*"):
+            if path.is_file():
+                text = path.read_text(errors="replace")
+                leaks += [(path, n) for n in names | lines if n in text]
     assert leaks == []
 
 
