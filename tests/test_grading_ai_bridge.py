@@ -8,77 +8,46 @@ it, with partial credit for the share of the way it covered.
 
 from __future__ import annotations
 
-from concurrent.futures import ThreadPoolExecutor
 from fractions import Fraction
-from pathlib import Path
 
 import pytest
+from proving import (  # noqa: F401 - the standard checks, collected here
+    Proof,
+    failed_tests,
+    test_known_bad_variant_loses_the_test_aimed_at_it,
+    test_other_correct_designs_score_full_marks,
+    test_reference_scores_full_marks_every_time,
+    test_starter_is_below_the_pass_mark,
+)
 
-from autograder.exercise import find_exercise
-from autograder.grading import grade
 from autograder.results import RunResult
 
 pytestmark = pytest.mark.slow
 
-EXERCISE = find_exercise("ai_bridge")
-SUBMISSIONS = Path(__file__).parent / "submissions" / "ai_bridge"
+PROOF = Proof(
+    "ai_bridge",
+    correct=('grid_planner',),
+    # Each known-bad variant, and the tests aimed at what it gets wrong.
+    mutants={
+        "ignores_obstacles": frozenset({"test_obstacles_reaches_goal",
+                                        "test_corridor_reaches_goal"}),
+        "never_reports": frozenset({"test_open_room_reports_arrival"}),
+        "stops_short": frozenset({"test_open_room_reaches_goal", "test_obstacles_reaches_goal",
+                                  "test_corridor_reaches_goal"}),
+        "wanders": frozenset({"test_open_room_efficient_path"}),
+    },
+    jobs=3,
+)
 
-CORRECT = ["grid_planner"]
-# Each known-bad agent, and the tests aimed at what it gets wrong.
-MUTANTS = {
-    "ignores_obstacles": {"test_obstacles_reaches_goal", "test_corridor_reaches_goal"},
-    "never_reports": {"test_open_room_reports_arrival"},
-    "stops_short": {"test_open_room_reaches_goal", "test_obstacles_reaches_goal",
-                    "test_corridor_reaches_goal"},
-    "wanders": {"test_open_room_efficient_path"},
-}
-REPEATS = 5
+
+@pytest.fixture(scope="module")
+def proof() -> Proof:
+    return PROOF
 
 
 @pytest.fixture(scope="module")
 def graded() -> dict[str, RunResult]:
-    """Grade everything once, two gradings at a time (as `grade-batch --jobs 2` would)."""
-    jobs: dict[str, Path | None] = {f"reference#{i}": None for i in range(REPEATS)}
-    jobs["starter"] = EXERCISE.starter
-    for name in [*CORRECT, *MUTANTS]:
-        jobs[name] = SUBMISSIONS / name
-    with ThreadPoolExecutor(max_workers=2) as pool:
-        futures = {name: pool.submit(grade, EXERCISE, path) for name, path in jobs.items()}
-        return {name: future.result() for name, future in futures.items()}
-
-
-def failed_tests(result: RunResult) -> set[str]:
-    return {t.name for t in result.tests if t.status != "passed"}
-
-
-def test_reference_scores_full_marks_every_time(graded):
-    results = [graded[f"reference#{i}"] for i in range(REPEATS)]
-    assert [r.grader_error for r in results] == [None] * REPEATS
-    assert {(r.score, r.max_score) for r in results} == {(14, 14)}, \
-        [failed_tests(r) for r in results]
-    assert all(r.passed for r in results)
-
-
-def test_starter_is_below_the_pass_mark(graded):
-    result = graded["starter"]
-    assert result.grader_error is None
-    assert not result.passed
-    assert 0 < result.score < result.max_score * result.pass_mark
-
-
-@pytest.mark.parametrize("name", CORRECT)
-def test_other_correct_designs_score_full_marks(graded, name):
-    result = graded[name]
-    assert result.grader_error is None
-    assert result.score == result.max_score, failed_tests(result)
-
-
-@pytest.mark.parametrize("name", list(MUTANTS))
-def test_known_bad_variant_loses_the_tests_aimed_at_it(graded, name):
-    result = graded[name]
-    assert result.grader_error is None
-    assert result.score < result.max_score
-    assert MUTANTS[name] <= failed_tests(result), failed_tests(result)
+    return PROOF.grade_all()
 
 
 def test_progress_earns_partial_credit(graded):

@@ -10,82 +10,45 @@ this module short; gradings run two at a time, on their own ROS domains.
 
 from __future__ import annotations
 
-from concurrent.futures import ThreadPoolExecutor
-from pathlib import Path
-
 import pytest
+from proving import (  # noqa: F401 - the standard checks, collected here
+    Proof,
+    failed_tests,
+    test_known_bad_variant_loses_the_test_aimed_at_it,
+    test_other_correct_designs_score_full_marks,
+    test_reference_scores_full_marks_every_time,
+    test_starter_is_below_the_pass_mark,
+)
 
-from autograder.exercise import find_exercise
-from autograder.grading import grade
 from autograder.results import RunResult
 
 pytestmark = pytest.mark.slow
 
-EXERCISE = find_exercise("error_handling")
-SUBMISSIONS = Path(__file__).parent / "submissions" / "error_handling"
+PROOF = Proof(
+    "error_handling",
+    correct=('multithreaded', 'spin_once_loop', 'sigwait_future'),
+    # Each known-bad variant, and the tests aimed at what it gets wrong.
+    mutants={
+        "crashes_on_nan": frozenset({"test_ignores_invalid_readings"}),
+        "no_watchdog": frozenset({"test_watchdog_stops"}),
+        "floods_log": frozenset({"test_log_not_flooded"}),
+        "no_empty_scan_check": frozenset({"test_rejects_malformed_scans"}),
+        "exception_kills_node": frozenset({"test_survives_exceptions"}),
+        "traceback_on_sigint": frozenset({"test_clean_exit_on_sigint",
+                                          "test_clean_exit_on_sigterm"}),
+    },
+    jobs=3,
+)
 
-CORRECT = ["multithreaded", "spin_once_loop", "sigwait_future"]
-# Each known-bad variant, the tests aimed at what it gets wrong, and whether the hidden
-# tests are needed to show it.
-MUTANTS = {
-    "crashes_on_nan": ({"test_ignores_invalid_readings"}, False),
-    "no_watchdog": ({"test_watchdog_stops"}, False),
-    "floods_log": ({"test_log_not_flooded"}, True),
-    "no_empty_scan_check": ({"test_rejects_malformed_scans"}, False),
-    "exception_kills_node": ({"test_survives_exceptions"}, False),
-    "traceback_on_sigint": ({"test_clean_exit_on_sigint", "test_clean_exit_on_sigterm"}, True),
-}
-REPEATS = 5
+
+@pytest.fixture(scope="module")
+def proof() -> Proof:
+    return PROOF
 
 
 @pytest.fixture(scope="module")
 def graded() -> dict[str, RunResult]:
-    """Grade everything once, two gradings at a time (as `grade-batch --jobs 2` would)."""
-    jobs: dict[str, tuple[Path | None, bool]] = {
-        f"reference#{i}": (None, True) for i in range(REPEATS)}
-    jobs["starter"] = (EXERCISE.starter, True)
-    for name in CORRECT:
-        jobs[name] = (SUBMISSIONS / name, True)
-    for name, (_aimed, hidden) in MUTANTS.items():
-        jobs[name] = (SUBMISSIONS / name, hidden)
-    with ThreadPoolExecutor(max_workers=2) as pool:
-        futures = {name: pool.submit(grade, EXERCISE, path, hidden=hidden)
-                   for name, (path, hidden) in jobs.items()}
-        return {name: future.result() for name, future in futures.items()}
-
-
-def failed_tests(result: RunResult) -> set[str]:
-    return {t.name for t in result.tests if t.status != "passed"}
-
-
-def test_reference_scores_full_marks_every_time(graded):
-    results = [graded[f"reference#{i}"] for i in range(REPEATS)]
-    assert [r.grader_error for r in results] == [None] * REPEATS
-    assert {(r.score, r.max_score) for r in results} == {(24, 24)}, \
-        [failed_tests(r) for r in results]
-    assert all(r.passed for r in results)
-
-
-def test_starter_is_below_the_pass_mark(graded):
-    result = graded["starter"]
-    assert result.grader_error is None
-    assert not result.passed
-    assert 0 < result.score < result.max_score * result.pass_mark
-
-
-@pytest.mark.parametrize("name", CORRECT)
-def test_other_correct_designs_score_full_marks(graded, name):
-    result = graded[name]
-    assert result.grader_error is None
-    assert result.score == result.max_score, failed_tests(result)
-
-
-@pytest.mark.parametrize("name", list(MUTANTS))
-def test_known_bad_variant_loses_the_tests_aimed_at_it(graded, name):
-    result = graded[name]
-    assert result.grader_error is None
-    assert result.score < result.max_score
-    assert MUTANTS[name][0] <= failed_tests(result), failed_tests(result)
+    return PROOF.grade_all()
 
 
 def test_a_dead_or_silent_node_is_named_as_such(graded):
