@@ -24,6 +24,9 @@ def pytest_generate_tests(metafunc: pytest.Metafunc) -> None:
     if proof is None:
         return
     if "correct" in metafunc.fixturenames:
-        metafunc.parametrize("correct", list(proof.correct))
+        flaky = getattr(metafunc.module, "KNOWN_FLAKY", {})
+        metafunc.parametrize("correct", [
+            pytest.param(name, marks=pytest.mark.xfail(reason=flaky[name], strict=False))
+            if name in flaky else name for name in proof.correct])
     if "mutant" in metafunc.fixturenames:
         metafunc.parametrize("mutant", list(proof.mutants))
