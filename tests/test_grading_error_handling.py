@@ -40,9 +40,11 @@ PROOF = Proof(
     jobs=2,
 )
 # An open grader bug, kept visible rather than dropped from the proof: under heavy load
-# (CI, three gradings at a time) this correct design twice missed the dropout stop.
+# (a full CI run) this correct design lost one test in each of three runs: twice the
+# dropout stop, once the clean exit on SIGTERM.
 KNOWN_FLAKY = {"multithreaded": "open grader bug: under heavy load this correct "
-               "multi-threaded design has missed test_stops_during_dropout (2 CI runs)"}
+               "multi-threaded design has lost test_stops_during_dropout or "
+               "test_clean_exit_on_sigterm (3 CI runs)"}
 
 
 @pytest.fixture(scope="module")
