@@ -136,11 +136,9 @@ def _reap(child: subprocess.Popen[bytes], report: dict[str, Any]) -> None:
             os.killpg(process["pid"], signal.SIGKILL)
         except (ProcessLookupError, PermissionError):
             pass
-        for path in process.get("cgroups", []):
-            group = Cgroup.__new__(Cgroup)
-            group.paths = [Path(path)]
-            group.kill_all()
-            group.remove()
+        group = Cgroup.existing(process.get("cgroups", []))
+        group.kill_all()
+        group.remove()
 
 
 def _score(status: str, max_score: Fraction, fraction: float | None) -> Fraction:

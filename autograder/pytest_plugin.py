@@ -13,6 +13,7 @@ Points and visibility travel through markers::
 
 from __future__ import annotations
 
+import contextlib
 import itertools
 import json
 import os
@@ -300,7 +301,7 @@ def ros_context(pytestconfig: pytest.Config) -> Iterator[Any]:
     else:
         os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
     given = pytestconfig.getoption("ros_domain")
-    with reserve_domain(None) if given is None else _held(given) as domain:
+    with reserve_domain(None) if given is None else contextlib.nullcontext(given) as domain:
         os.environ["ROS_DOMAIN_ID"] = str(domain)
         context = Context()
         rclpy.init(context=context, domain_id=domain)
@@ -313,19 +314,6 @@ def ros_context(pytestconfig: pytest.Config) -> Iterator[Any]:
 def _strict() -> bool:
     """True inside a grading run in its own namespaces (see autograder.isolation)."""
     return os.environ.get("AUTOGRADER_RUN_ISOLATION") == "strict"
-
-
-class _held:
-    """A domain already reserved by the parent process."""
-
-    def __init__(self, domain: int) -> None:
-        self.domain = domain
-
-    def __enter__(self) -> int:
-        return self.domain
-
-    def __exit__(self, *exc: object) -> None:
-        return None
 
 
 @pytest.fixture(scope="module")

@@ -47,6 +47,13 @@ class Cgroup:
                 continue
             self.paths.append(path)
 
+    @classmethod
+    def existing(cls, paths: list[str]) -> Cgroup:
+        """A run's cgroups known by path (to reap them from another process)."""
+        group = cls.__new__(cls)
+        group.paths = [Path(p) for p in paths]
+        return group
+
     @property
     def available(self) -> bool:
         return bool(self.paths)
