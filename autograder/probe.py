@@ -8,6 +8,7 @@ a stalled world or a hung node ends a test with a message instead of hanging it.
 from __future__ import annotations
 
 import threading
+import time
 from collections.abc import Callable, Iterable
 from typing import Any, Generic, TypeVar
 
@@ -33,7 +34,8 @@ class Inbox(Generic[M]):
     def __init__(self, topic: str) -> None:
         self.topic = topic
         self._items: list[tuple[float, M]] = []
-        self._lock = threading.Lock()
+        self._lock = threading.Condition()
+        self._arrivals = 0  # counts dropped messages too: a flood is not quiet
         self.subscription: Any = None
         self.dropped = 0
 
@@ -50,6 +52,36 @@ class Inbox(Generic[M]):
                 self._items.append((stamp, message))
             else:
                 self.dropped += 1
+            self._arrivals += 1
+            self._lock.notify_all()
+
+    def wait_until(self, condition: Callable[[], bool], wall_timeout: float) -> bool:
+        """Wait, in wall time, until ``condition()`` holds after some message arrived
+        (checked at once, then on each arrival); False at the deadline.
+
+        For when simulation time is no measure, e.g. after the node's process ended.
+        """
+        end = time.monotonic() + wall_timeout
+        with self._lock:
+            while not condition():
+                left = end - time.monotonic()
+                if left <= 0:
+                    return False
+                self._lock.wait(left)
+            return True
+
+    def wait_quiet(self, quiet: float, limit: float) -> bool:
+        """Wait until no message has arrived for ``quiet`` wall seconds; False if messages
+        still came after ``limit`` seconds."""
+        end = time.monotonic() + limit
+        with self._lock:
+            while True:
+                seen, now = self._arrivals, time.monotonic()
+                if now >= end:
+                    return False
+                self._lock.wait(min(quiet, end - now))
+                if self._arrivals == seen and time.monotonic() - now >= quiet - 1e-3:
+                    return True
 
     @property
     def items(self) -> list[tuple[float, M]]:
@@ -131,6 +163,16 @@ class Probe:
                   "node kept the machine too busy.").format(seconds=wall),
                 _("Look for busy loops; use timers and callbacks instead of while loops."))
         return False
+
+    def settle(self, inbox: Inbox[Any], quiet: float = 0.05, limit: float = 1.0) -> None:
+        """Hold simulation time until nothing new has reached ``inbox`` for ``quiet`` wall
+        seconds (at most ``limit``): then it holds all the node sent so far, however late a
+        busy machine delivers it (the world waits for the node, not for the probe)."""
+        self.world.pause()
+        try:
+            inbox.wait_quiet(quiet, limit)
+        finally:
+            self.world.resume()
 
     def wait_sim(self, seconds: float) -> None:
         """Let ``seconds`` of simulation time pass (the world keeps running meanwhile)."""

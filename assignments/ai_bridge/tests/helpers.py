@@ -7,7 +7,6 @@ never asks the node where it thinks it is.
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -70,22 +69,6 @@ class Mission:
         return min(self.samples, key=lambda s: abs(s.t - t), default=None)
 
 
-def _drain(world: Any, inbox: Any, quiet: float = 0.05, limit: float = 1.0) -> None:
-    """Hold simulation time until nothing has reached ``inbox`` for ``quiet`` wall seconds:
-    a busy machine may deliver the node's messages late, and the world waits for the
-    node, not for us."""
-    world.pause()
-    try:
-        end = time.monotonic() + limit
-        count, changed = len(inbox), time.monotonic()
-        while time.monotonic() < end and time.monotonic() - changed < quiet:
-            time.sleep(0.01)
-            if len(inbox) != count:
-                count, changed = len(inbox), time.monotonic()
-    finally:
-        world.resume()
-
-
 def fly(world: Any, probe: Any, student: Any, limit: float) -> Mission:
     """Watch the robot until it stops within REACHED of the goal (then STATUS_WITHIN more),
     collides, its node dies, or ``limit`` seconds of simulation time pass."""
@@ -114,7 +97,7 @@ def fly(world: Any, probe: Any, student: Any, limit: float) -> Mission:
     if arrived():
         mission.arrived_at = probe.now
         probe.wait_sim(STATUS_WITHIN)
-        _drain(world, status)
+        probe.settle(status)
     elif not student.running():
         mission.died_at = probe.now
     mission.end = probe.now

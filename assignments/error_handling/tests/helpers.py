@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import math
 import re
-import time
 from collections.abc import Callable
 from typing import Any
 
@@ -99,25 +98,9 @@ def describe(t: Twist) -> str:
     return f"linear.x={t.linear.x:.3g}, angular.z={t.angular.z:.3g}"
 
 
-def drain(world: Any, inbox: Any, quiet: float = 0.05, limit: float = 1.0) -> None:
-    """Hold simulation time until no message has reached ``inbox`` for ``quiet`` wall
-    seconds (at most ``limit``): then it holds all the node sent so far, however busy the
-    machine (the world waits for the node, not for us)."""
-    world.pause()
-    try:
-        end = time.monotonic() + limit
-        count, changed = len(inbox), time.monotonic()
-        while time.monotonic() < end and time.monotonic() - changed < quiet:
-            time.sleep(0.01)
-            if len(inbox) != count:
-                count, changed = len(inbox), time.monotonic()
-    finally:
-        world.resume()
-
-
 def alive(probe: Any, inbox: Any, node: Any, when: str) -> None:
     """Fail with the node's last words if its process ended or it stopped publishing."""
-    drain(probe.world, inbox)
+    probe.settle(inbox)
     if not node.running():
         raise StudentFailure(
             _("The node's process ended {when} (exit status {code}). Its last lines:\n{tail}")

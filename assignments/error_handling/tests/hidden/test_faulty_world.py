@@ -13,7 +13,7 @@ import time
 from typing import Any
 
 import pytest
-from helpers import LATE, describe, drain, is_zero, warnings_between, window
+from helpers import LATE, describe, is_zero, warnings_between, window
 
 from autograder.errors import StudentFailure
 from autograder.i18n import _
@@ -94,14 +94,14 @@ def run(world, probe, student, commands) -> Run:
         while died_at is None and probe.now < when - 1e-9:
             probe.wait_for(lambda w=when: probe.now >= w or gone(), when - probe.now)
             if gone():
-                drain(world, commands)  # silent, or only slow to reach us?
+                probe.settle(commands)  # silent, or only slow to reach us?
                 died_at = probe.now if gone() else None
         if died_at is not None:
             break
         if dropout is not None:
             setattr(dropout, field, time.time())
     probe.wait_sim(0.3)
-    drain(world, commands)  # everything it sent is in
+    probe.settle(commands)  # everything it sent is in
     return Run(t0, t0 + RUN, dropouts, died_at, commands, student.output())
 
 

@@ -9,7 +9,6 @@ Exiting is the process's business, so it is timed in wall seconds: the contract 
 from __future__ import annotations
 
 import signal
-import time
 
 import pytest
 from geometry_msgs.msg import Twist
@@ -22,7 +21,8 @@ pytestmark = pytest.mark.world("empty_room")
 
 TRIALS = 3
 EXIT_WITHIN = 5.0
-ARRIVE_WITHIN, STRAGGLERS = 3.0, 0.5  # wall seconds for its last messages to reach us
+# Wall seconds for its last messages to reach us, and of quiet that says all came.
+ARRIVE_WITHIN, STRAGGLERS = 3.0, 0.5
 HINT = _("Use rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO), spin an "
          "executor in a thread, wait on a threading.Event set by your own SIGINT/SIGTERM "
          "handlers, then stop spinning, publish Twist(), wait_for_all_acked, destroy the node "
@@ -60,11 +60,9 @@ def _trial(probe, start_node, sig: signal.Signals, trial: int) -> None:
         return bool(messages) and is_zero(messages[-1])
 
     # The process has ended: what it sent is on its way, and reaches us in wall time
-    # (simulation time now runs freely). Wait for the stop, then for stragglers.
-    deadline = time.monotonic() + ARRIVE_WITHIN
-    while not stopped() and time.monotonic() < deadline:
-        time.sleep(0.02)
-    time.sleep(STRAGGLERS)
+    # (simulation time now runs freely). Wait for the stop, then until nothing more comes.
+    commands.wait_until(stopped, ARRIVE_WITHIN)
+    commands.wait_quiet(STRAGGLERS, ARRIVE_WITHIN)
     if not stopped():
         last = commands.messages[-1]
         raise StudentFailure(

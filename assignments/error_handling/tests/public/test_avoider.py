@@ -18,7 +18,6 @@ from helpers import (
     alive,
     blocked,
     describe,
-    drain,
     is_forward,
     is_zero,
     make_scan,
@@ -50,7 +49,7 @@ def avoider(feeder, student, start_node, probe, commands):
     node = student
     if node.running():
         probe.wait_sim(SILENT)
-        drain(probe.world, commands)
+        probe.settle(commands)
     if node.running() and not (commands.times and commands.times[-1] >= probe.now - SILENT):
         node.stop()  # running but silent: an exception ended the thread that spins it
     if not node.running():
@@ -69,7 +68,7 @@ def test_publishes_at_10_hz(avoider, feeder, probe, commands):
     probe.wait_sim(0.5)
     start = probe.now
     probe.wait_sim(3.0)
-    drain(probe.world, commands)
+    probe.settle(commands)
     count = len(window(commands, start, start + 3.0))
     if not 24 <= count <= 36:  # 10 Hz, give or take cycles a busy machine may cost
         raise StudentFailure(
@@ -84,7 +83,7 @@ def test_drives_when_clear(avoider, feeder, probe, commands):
     """With a clear way ahead, it drives forward at 0.2 m/s"""
     start = settle_forward(probe, commands, feeder, avoider)
     probe.wait_sim(1.0)
-    drain(probe.world, commands)
+    probe.settle(commands)
     wrong = [m for m in window(commands, start, probe.now) if not is_forward(m)]
     if wrong:
         raise StudentFailure(
@@ -115,7 +114,7 @@ def test_watchdog_stops(avoider, feeder, probe, commands):
     settle_forward(probe, commands, feeder, avoider)
     silent = feeder.feed(None)
     probe.wait_sim(2.5)
-    drain(probe.world, commands)
+    probe.settle(commands)
     late = window(commands, silent + 0.5 + 0.2 + LATE, probe.now)
     moving = [m for m in late if not is_zero(m)]
     if moving or len(late) < 13:

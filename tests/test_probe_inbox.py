@@ -1,0 +1,55 @@
+"""The probe's Inbox: what it keeps of a flood, and its waits on arrivals (no ROS needed)."""
+
+from __future__ import annotations
+
+import threading
+
+from autograder.probe import Inbox
+
+
+def test_a_flood_is_counted_not_kept(monkeypatch):
+    monkeypatch.setattr(Inbox, "LIMIT", 3)
+    inbox: Inbox[int] = Inbox("/cmd_vel")
+    for i in range(5):
+        inbox.add(float(i), i)
+    assert inbox.messages == [0, 1, 2]
+    assert inbox.dropped == 2
+
+
+def test_wait_until_wakes_on_the_arrival_that_makes_it_true():
+    inbox: Inbox[str] = Inbox("/cmd_vel")
+    sender = threading.Thread(target=lambda: [inbox.add(0.0, "go"), inbox.add(0.1, "stop")])
+    sender.start()
+    assert inbox.wait_until(lambda: inbox.messages[-1:] == ["stop"], wall_timeout=10.0)
+    sender.join()
+
+
+def test_wait_until_gives_up_at_its_deadline():
+    inbox: Inbox[str] = Inbox("/cmd_vel")
+    inbox.add(0.0, "go")
+    assert not inbox.wait_until(lambda: inbox.messages[-1] == "stop", wall_timeout=0.05)
+
+
+def test_wait_quiet_returns_once_nothing_arrives():
+    inbox: Inbox[int] = Inbox("/cmd_vel")
+    inbox.add(0.0, 1)
+    assert inbox.wait_quiet(quiet=0.02, limit=5.0)
+
+
+def test_wait_quiet_is_not_fooled_by_a_flood_even_past_the_limit(monkeypatch):
+    monkeypatch.setattr(Inbox, "LIMIT", 10)  # dropped messages still count as arrivals
+    inbox: Inbox[int] = Inbox("/cmd_vel")
+    done = threading.Event()
+
+    def flood() -> None:
+        while not done.is_set():
+            inbox.add(0.0, 0)
+
+    flooder = threading.Thread(target=flood)
+    flooder.start()
+    try:
+        assert not inbox.wait_quiet(quiet=0.2, limit=0.6)
+    finally:
+        done.set()
+        flooder.join()
+    assert inbox.dropped > 0
