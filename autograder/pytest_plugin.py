@@ -339,6 +339,8 @@ def world(request: pytest.FixtureRequest, exercise: Any, ros_context: Any) -> It
         reporter = request.config.stash.get(reporter_key, None)
         if reporter is not None:
             reporter.data["recordings"][request.node.name] = bridge.recording.to_dict()
+            reporter.data.setdefault("pacing", {})[request.node.name] = {
+                **bridge.pacing, "longest_hold": round(bridge.longest_hold, 3)}
 
 
 @pytest.fixture(scope="module")

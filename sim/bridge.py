@@ -121,6 +121,10 @@ class SimBridge:
         # (time.time_ns() just before a tick's /clock went out, that tick's sim time)
         self._clock_log: list[tuple[int, float]] = []
         self._threads: list[threading.Thread] = []
+        # How each tick's hold for the watched processes ended: no process watched
+        # ("free"), all idle ("idle"), CPU share used ("budget"), or the wall cap ("cap").
+        self.pacing: collections.Counter[str] = collections.Counter()
+        self.longest_hold = 0.0  # wall seconds of the longest such hold
         self.node = Node(node_name, context=context)
         qos = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
         self._clock_pub = self.node.create_publisher(Clock, "/clock", qos)
@@ -311,6 +315,7 @@ class SimBridge:
         """
         pids = tuple(self._pids)
         if not pids:
+            self.pacing["free"] += 1
             return
         first = published + self.settle
         now = time.monotonic()
@@ -320,15 +325,21 @@ class SimBridge:
         budget = int(self.cpu_budget * 1e9)
         cap = published + self.quiescence_cap
         while time.monotonic() < cap:
-            waiting = False
+            outcome = "idle"
             for pid in pids:
                 busy, cpu = process_state(pid)
-                if busy and cpu - start[pid] < budget:
-                    waiting = True
-                    break
-            if not waiting:
-                return
+                if busy:
+                    outcome = "budget"
+                    if cpu - start[pid] < budget:
+                        outcome = ""
+                        break
+            if outcome:
+                break
             time.sleep(self.poll_interval)
+        else:
+            outcome = "cap"
+        self.pacing[outcome] += 1
+        self.longest_hold = max(self.longest_hold, time.monotonic() - published)
 
     def _tick(self, steps: int) -> None:
         """Advance ``steps`` physics steps and publish clock, odometry and scans."""
