@@ -33,7 +33,8 @@ NON_ROS_DEPENDENCIES = ["pymunk>=6.6", "numpy>=1.24", "jinja2>=3.1", "babel>=2.1
 JOBS = {
     "demo": [["autograder", "grade", "parameter_validation",
               "assignments/parameter_validation/solution"]],
-    "test": [["python", "-m", "pytest"]],
+    # The ten slowest steps close the run: where the suite's minutes go, in every CI log.
+    "test": [["python", "-m", "pytest", "--durations=10"]],
     "lint": [["ruff", "check", "."]],
     "bench": [["python", "benchmarks/bench_grading.py"], ["python", "benchmarks/bench_sim.py"]],
 }

@@ -208,4 +208,5 @@ def _result(exercise: Exercise, report: dict[str, Any], returncode: int | None,
         grader_details=details, log_tail="\n".join(logs.values())[-4000:],
         execution_time=elapsed,
         data={"recordings": data.get("recordings", {}), "timed_out": timed_out,
-              "startup_seconds": data.get("startup_seconds", [])})
+              "startup_seconds": data.get("startup_seconds", []),
+              "pacing": data.get("pacing", {})})

@@ -168,11 +168,8 @@ class Probe:
         """Hold simulation time until nothing new has reached ``inbox`` for ``quiet`` wall
         seconds (at most ``limit``): then it holds all the node sent so far, however late a
         busy machine delivers it (the world waits for the node, not for the probe)."""
-        self.world.pause()
-        try:
+        with self.world.held():
             inbox.wait_quiet(quiet, limit)
-        finally:
-            self.world.resume()
 
     def wait_sim(self, seconds: float) -> None:
         """Let ``seconds`` of simulation time pass (the world keeps running meanwhile)."""

@@ -478,6 +478,9 @@ def launch(request: pytest.FixtureRequest, exercise: Any, script: Path, probe: A
     if strict:
         process.uid = student_uid(domain)
         process.hide = protected_paths(exercise.folder.parent.parent)
+    # An earlier instance may still be on the graph (a killed process lingers until its
+    # lease runs out): only endpoints that were not there before are this instance's.
+    stale = _node_endpoints(probe, exercise.node) if wait_for_node else set()
     process.start()
     reporter = request.config.stash.get(reporter_key, None)
     if reporter is not None:
@@ -490,7 +493,7 @@ def launch(request: pytest.FixtureRequest, exercise: Any, script: Path, probe: A
             node.stop()
             raise StudentFailure(earlier.message, earlier.hint)
         try:
-            _wait_for_node(exercise, node, world)
+            _wait_for_node(exercise, node, world, stale)
         except NodeNeverAppeared as failure:
             request.config.stash[startup_key] = failure
             raise
@@ -529,17 +532,41 @@ class NodeNeverAppeared(StudentFailure):
     """The program ran, but its node never showed up on the graph (not a crash)."""
 
 
-def _wait_for_node(exercise: Any, node: StudentNode, world: Any) -> None:
+# Every rclpy node publishes on these (its log and its parameter events): the endpoints
+# that tell one instance of a node from another of the same name.
+NODE_TOPICS = ("/rosout", "/parameter_events")
+
+
+def _node_endpoints(probe: Any, name: str) -> set[bytes]:
+    """The GIDs of the publishers node ``name`` has on NODE_TOPICS, as the graph shows."""
+    return {bytes(info.endpoint_gid) for topic in NODE_TOPICS
+            for info in probe.node.get_publishers_info_by_topic(topic)
+            if info.node_name == name}
+
+
+def _wait_for_node(exercise: Any, node: StudentNode, world: Any, stale: set[bytes]) -> None:
+    """Wait, with simulation time held, until this instance's node is on the graph: a
+    start-up is then the same in simulation time however long the machine takes (imports,
+    discovery), and the node's first tick is the next one."""
     deadline = time.monotonic() + exercise.startup_timeout
     seen: set[str] = set()
 
-    def ready() -> bool:
+    def appeared() -> bool:
         nonlocal seen
         seen = node.probe.node_names()
-        return exercise.node in seen or not node.running() or time.monotonic() > deadline
+        if exercise.node not in seen:
+            return False
+        # A node of this name was already there: wait for endpoints it did not have.
+        return not stale or bool(_node_endpoints(node.probe, exercise.node) - stale)
 
-    world.wait_for(ready, sim_timeout=float("inf"), wall_timeout=exercise.startup_timeout + 1)
-    if exercise.node in seen:
+    def ready() -> bool:
+        return appeared() or not node.running() or time.monotonic() > deadline
+
+    with world.held():
+        world.wait_for(ready, sim_timeout=float("inf"),
+                       wall_timeout=exercise.startup_timeout + 1)
+        found = appeared()
+    if found:
         node.startup_seconds = time.monotonic() - node.process.started_at
         return
     tail = _tail_with_size(node)

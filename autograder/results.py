@@ -133,6 +133,9 @@ class RunResult:
             "grader_error": self.grader_error,
             "execution_time": round(self.execution_time, 3),
             **({"isolation": self.data["isolation"]} if "isolation" in self.data else {}),
+            # How the world paced itself per test module (see sim/bridge.py): for instructors
+            # asking whether a verdict came from a slow node or a starved one.
+            **({"pacing": self.data["pacing"]} if self.data.get("pacing") else {}),
             "tests": [
                 {
                     "name": t.name,

@@ -37,10 +37,11 @@ from __future__ import annotations
 import array
 import bisect
 import collections
+import contextlib
 import math
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 from geometry_msgs.msg import Twist
@@ -166,6 +167,18 @@ class SimBridge:
             self._paused = False
             self._window.clear()
             self._cond.notify_all()
+
+    @contextlib.contextmanager
+    def held(self) -> Iterator[None]:
+        """Sim time stands still inside the block; afterwards the world runs again, unless it
+        was paused before."""
+        with self._cond:
+            was_paused, self._paused = self._paused, True
+        try:
+            yield
+        finally:
+            if not was_paused:
+                self.resume()
 
     def step(self, n: int = 1) -> None:
         """While paused, advance ``n`` physics steps as one tick and publish it."""
