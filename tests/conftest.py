@@ -24,9 +24,6 @@ def pytest_generate_tests(metafunc: pytest.Metafunc) -> None:
     if proof is None:
         return
     if "correct" in metafunc.fixturenames:
-        flaky = getattr(metafunc.module, "KNOWN_FLAKY", {})
-        metafunc.parametrize("correct", [
-            pytest.param(name, marks=pytest.mark.xfail(reason=flaky[name], strict=False))
-            if name in flaky else name for name in proof.correct])
+        metafunc.parametrize("correct", list(proof.correct))
     if "mutant" in metafunc.fixturenames:
         metafunc.parametrize("mutant", list(proof.mutants))
