@@ -1,0 +1,94 @@
+"""How the grader waits for a student's node to start (graph and world stood in by fakes).
+
+A restarted program's node has the name of the instance before it, which lingers on the
+graph (a killed process stays listed until its DDS lease runs out): only publishers the
+graph did not show before the start may count as the new instance's.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+from collections.abc import Callable, Iterator
+from types import SimpleNamespace
+
+from autograder.pytest_plugin import StudentNode, _node_endpoints, _wait_for_node
+
+NAME = "obstacle_avoider"
+
+
+@dataclasses.dataclass
+class Info:
+    node_name: str
+    endpoint_gid: bytes
+
+
+class Graph:
+    """What the probe's node sees; ``later`` joins after ``delay`` looks at the graph."""
+
+    def __init__(self, now: list[Info], later: list[Info] = (), delay: int = 0) -> None:
+        self.now, self.later, self.delay, self.looks = list(now), list(later), delay, 0
+
+    def get_publishers_info_by_topic(self, topic: str) -> list[Info]:
+        return list(self.now)
+
+    def names(self) -> set[str]:
+        self.looks += 1
+        if self.looks > self.delay:
+            self.now += self.later
+            self.later = []
+        return {info.node_name for info in self.now} | {"sim_world", "autograder_probe"}
+
+
+class World:
+    def __init__(self) -> None:
+        self.holding = False
+        self.held_while_waiting: list[bool] = []
+
+    @contextlib.contextmanager
+    def held(self) -> Iterator[None]:
+        self.holding = True
+        try:
+            yield
+        finally:
+            self.holding = False
+
+    def wait_for(self, predicate: Callable[[], bool], sim_timeout: float,
+                 wall_timeout: float) -> bool:
+        for _ in range(1000):
+            self.held_while_waiting.append(self.holding)
+            if predicate():
+                return True
+        return False
+
+
+def start(graph: Graph, world: World, stale: set[bytes]) -> StudentNode:
+    probe = SimpleNamespace(node=graph, node_names=graph.names, world=world)
+    process = SimpleNamespace(running=lambda: True, started_at=0.0, returncode=None)
+    node = StudentNode(process, NAME, probe)
+    exercise = SimpleNamespace(node=NAME, startup_timeout=20.0, file="obstacle_avoider.py")
+    _wait_for_node(exercise, node, world, stale)
+    return node
+
+
+def test_a_restart_waits_for_the_new_instance_not_the_lingering_one():
+    old, new = Info(NAME, b"old"), Info(NAME, b"new")
+    graph, world = Graph([old], [new], delay=5), World()
+    stale = _node_endpoints(SimpleNamespace(node=graph), NAME)
+    assert stale == {b"old"}
+    start(graph, world, stale)
+    assert len(world.held_while_waiting) == 6  # not before the new instance showed
+    assert all(world.held_while_waiting) and not world.holding
+
+
+def test_a_first_start_is_done_when_the_name_appears():
+    graph, world = Graph([], [Info(NAME, b"first")], delay=2), World()
+    node = start(graph, world, stale=set())
+    assert len(world.held_while_waiting) == 3  # done on the look that found it
+    assert node.startup_seconds is not None
+    assert all(world.held_while_waiting) and not world.holding
+
+
+def test_other_nodes_publishers_are_not_the_students():
+    graph = Graph([Info("sim_world", b"w"), Info(NAME, b"a"), Info("talker", b"t")])
+    assert _node_endpoints(SimpleNamespace(node=graph), NAME) == {b"a"}
