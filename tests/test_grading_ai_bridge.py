@@ -36,7 +36,7 @@ PROOF = Proof(
                                   "test_corridor_reaches_goal"}),
         "wanders": frozenset({"test_open_room_efficient_path"}),
     },
-    jobs=3,
+    jobs=4,
 )
 
 

@@ -4,7 +4,7 @@ The reference solution scores 100% (five times, with other gradings running besi
 the shutdown trials and the 60 s faulty run must not depend on load), the starter scores
 below the pass mark, every other correct design (other executors, other ways to take a
 signal) scores 100%, and each known-bad variant loses the tests aimed at it.  Every
-grading is a whole one; they run three at a time, on their own ROS domains.
+grading is a whole one; they run four at a time, on their own ROS domains.
 """
 
 from __future__ import annotations
@@ -36,7 +36,7 @@ PROOF = Proof(
         "traceback_on_sigint": frozenset({"test_clean_exit_on_sigint",
                                           "test_clean_exit_on_sigterm"}),
     },
-    jobs=3,
+    jobs=4,
 )
 
 

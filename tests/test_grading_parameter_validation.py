@@ -38,6 +38,7 @@ PROOF = Proof(
         "keeps_other_fields": frozenset({"test_other_fields_zero"}),
     },
     broken=("syntax_error", "crash_at_start", "never_spins", "wrong_node_name"),
+    jobs=3,
 )
 
 
