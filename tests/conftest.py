@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Iterator
+from typing import Any
 
 import pytest
 
@@ -27,3 +28,15 @@ def pytest_generate_tests(metafunc: pytest.Metafunc) -> None:
         metafunc.parametrize("correct", list(proof.correct))
     if "mutant" in metafunc.fixturenames:
         metafunc.parametrize("mutant", list(proof.mutants))
+
+
+@pytest.fixture(scope="module")
+def proof(request: pytest.FixtureRequest) -> Any:
+    """The module's PROOF (tests/proving.py)."""
+    return request.module.PROOF
+
+
+@pytest.fixture(scope="module")
+def graded(proof: Any) -> dict[str, Any]:
+    """Every submission of the module's PROOF, graded once for all its checks."""
+    return proof.grade_all()

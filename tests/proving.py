@@ -2,9 +2,9 @@
 beside other gradings), its starter, its other correct designs and its known-bad variants,
 then check what each scored.
 
-An exercise's project test declares ``PROOF = Proof(...)``, a ``graded`` fixture, and
-imports the standard checks below; ``correct`` and ``mutant`` arguments are parametrized
-from its PROOF by ``tests/conftest.py``.
+An exercise's project test declares ``PROOF = Proof(...)`` and imports the standard checks
+below; ``tests/conftest.py`` grades the PROOF once per module (the ``graded`` fixture) and
+parametrizes ``correct`` and ``mutant`` from it.
 """
 
 from __future__ import annotations

@@ -21,7 +21,6 @@ from proving import (  # noqa: F401 - the standard checks, collected here
 )
 
 from autograder.exercise import find_exercise
-from autograder.results import RunResult
 
 pytestmark = pytest.mark.slow
 
@@ -41,16 +40,6 @@ PROOF = Proof(
     # time (measured: six in parallel beside a busy loop kept every 10 Hz beat).
     jobs=5,
 )
-
-
-@pytest.fixture(scope="module")
-def proof() -> Proof:
-    return PROOF
-
-
-@pytest.fixture(scope="module")
-def graded() -> dict[str, RunResult]:
-    return PROOF.grade_all()
 
 
 def test_chapter_design_is_the_reference(graded):

@@ -19,8 +19,6 @@ from proving import (  # noqa: F401 - the standard checks, collected here
     test_starter_is_below_the_pass_mark,
 )
 
-from autograder.results import RunResult
-
 pytestmark = pytest.mark.slow
 
 PROOF = Proof(
@@ -38,16 +36,6 @@ PROOF = Proof(
     },
     jobs=4,
 )
-
-
-@pytest.fixture(scope="module")
-def proof() -> Proof:
-    return PROOF
-
-
-@pytest.fixture(scope="module")
-def graded() -> dict[str, RunResult]:
-    return PROOF.grade_all()
 
 
 def test_a_dead_or_silent_node_is_named_as_such(graded):

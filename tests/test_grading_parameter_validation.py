@@ -18,8 +18,6 @@ from proving import (  # noqa: F401 - the standard checks, collected here
     test_starter_is_below_the_pass_mark,
 )
 
-from autograder.results import RunResult
-
 pytestmark = pytest.mark.slow
 
 PROOF = Proof(
@@ -40,16 +38,6 @@ PROOF = Proof(
     broken=("syntax_error", "crash_at_start", "never_spins", "wrong_node_name"),
     jobs=3,
 )
-
-
-@pytest.fixture(scope="module")
-def proof() -> Proof:
-    return PROOF
-
-
-@pytest.fixture(scope="module")
-def graded() -> dict[str, RunResult]:
-    return PROOF.grade_all()
 
 
 def test_reference_max_score_is_the_exercise_points(graded):
