@@ -550,22 +550,19 @@ def _wait_for_node(exercise: Any, node: StudentNode, world: Any, stale: set[byte
     discovery), and the node's first tick is the next one."""
     deadline = time.monotonic() + exercise.startup_timeout
     seen: set[str] = set()
-
-    def appeared() -> bool:
-        nonlocal seen
-        seen = node.probe.node_names()
-        if exercise.node not in seen:
-            return False
-        # A node of this name was already there: wait for endpoints it did not have.
-        return not stale or bool(_node_endpoints(node.probe, exercise.node) - stale)
+    found = False
 
     def ready() -> bool:
-        return appeared() or not node.running() or time.monotonic() > deadline
+        nonlocal seen, found
+        seen = node.probe.node_names()
+        # A node of this name may already be there: then wait for endpoints it did not have.
+        found = exercise.node in seen and (
+            not stale or bool(_node_endpoints(node.probe, exercise.node) - stale))
+        return found or not node.running() or time.monotonic() > deadline
 
     with world.held():
         world.wait_for(ready, sim_timeout=float("inf"),
                        wall_timeout=exercise.startup_timeout + 1)
-        found = appeared()
     if found:
         node.startup_seconds = time.monotonic() - node.process.started_at
         return

@@ -337,20 +337,14 @@ class SimBridge:
         start = {pid: process_state(pid)[1] for pid in pids}
         budget = int(self.cpu_budget * 1e9)
         cap = published + self.quiescence_cap
+        outcome = "cap"
         while time.monotonic() < cap:
-            outcome = "idle"
-            for pid in pids:
-                busy, cpu = process_state(pid)
-                if busy:
-                    outcome = "budget"
-                    if cpu - start[pid] < budget:
-                        outcome = ""
-                        break
-            if outcome:
+            states = {pid: process_state(pid) for pid in pids}
+            if not any(busy and cpu - start[pid] < budget
+                       for pid, (busy, cpu) in states.items()):
+                outcome = "budget" if any(busy for busy, _ in states.values()) else "idle"
                 break
             time.sleep(self.poll_interval)
-        else:
-            outcome = "cap"
         self.pacing[outcome] += 1
         self.longest_hold = max(self.longest_hold, time.monotonic() - published)
 
