@@ -49,10 +49,15 @@ def failed_tests(result: RunResult) -> set[str]:
     return {t.name for t in result.tests if t.status != "passed"}
 
 
+def failures(result: RunResult) -> dict[str, str]:
+    """What each lost test said, so a failed proof in CI says why and not only which."""
+    return {t.name: f"{t.status}: {t.message}" for t in result.tests if t.status != "passed"}
+
+
 def test_reference_scores_full_marks_every_time(graded, proof):
     results = [graded[f"reference#{i}"] for i in range(proof.repeats)]
     assert [r.grader_error for r in results] == [None] * proof.repeats
-    assert all(r.score == r.max_score for r in results), [failed_tests(r) for r in results]
+    assert all(r.score == r.max_score for r in results), [failures(r) for r in results]
     assert len({r.max_score for r in results}) == 1
     assert all(r.passed for r in results)
 
@@ -67,11 +72,11 @@ def test_starter_is_below_the_pass_mark(graded):
 def test_other_correct_designs_score_full_marks(graded, correct):
     result = graded[correct]
     assert result.grader_error is None
-    assert result.score == result.max_score, failed_tests(result)
+    assert result.score == result.max_score, failures(result)
 
 
 def test_known_bad_variant_loses_the_test_aimed_at_it(graded, proof, mutant):
     result = graded[mutant]
     assert result.grader_error is None
     assert result.score < result.max_score
-    assert proof.mutants[mutant] <= failed_tests(result), failed_tests(result)
+    assert proof.mutants[mutant] <= failed_tests(result), failures(result)
