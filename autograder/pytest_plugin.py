@@ -478,8 +478,9 @@ def launch(request: pytest.FixtureRequest, exercise: Any, script: Path, probe: A
     if strict:
         process.uid = student_uid(domain)
         process.hide = protected_paths(exercise.folder.parent.parent)
-    # An earlier instance may still be on the graph (a killed process lingers until its
-    # lease runs out): only endpoints that were not there before are this instance's.
+    # An earlier instance may still be on the graph: its name until its participant's
+    # lease runs out, some of its endpoints too. Only publishers that were not there
+    # before the start are this instance's.
     stale = _node_endpoints(probe, exercise.node) if wait_for_node else set()
     process.start()
     reporter = request.config.stash.get(reporter_key, None)
@@ -555,9 +556,8 @@ def _wait_for_node(exercise: Any, node: StudentNode, world: Any, stale: set[byte
     def ready() -> bool:
         nonlocal seen, found
         seen = node.probe.node_names()
-        # A node of this name may already be there: then wait for endpoints it did not have.
-        found = exercise.node in seen and (
-            not stale or bool(_node_endpoints(node.probe, exercise.node) - stale))
+        # Not the name: an earlier instance's may linger after its endpoints are gone.
+        found = bool(_node_endpoints(node.probe, exercise.node) - stale)
         return found or not node.running() or time.monotonic() > deadline
 
     with world.held():

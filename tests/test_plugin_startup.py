@@ -1,8 +1,9 @@
 """How the grader waits for a student's node to start (graph and world stood in by fakes).
 
 A restarted program's node has the name of the instance before it, which lingers on the
-graph (a killed process stays listed until its DDS lease runs out): only publishers the
-graph did not show before the start may count as the new instance's.
+graph (a killed process stays listed until its DDS lease runs out, and the name can outlive
+the instance's endpoints): only publishers the graph did not show before the start may
+count as the new instance's, and a name alone never does.
 """
 
 from __future__ import annotations
@@ -26,8 +27,10 @@ class Info:
 class Graph:
     """What the probe's node sees; ``later`` joins after ``delay`` looks at the graph."""
 
-    def __init__(self, now: list[Info], later: list[Info] = (), delay: int = 0) -> None:
+    def __init__(self, now: list[Info], later: list[Info] = (), delay: int = 0,
+                 lingering: set[str] = frozenset()) -> None:
         self.now, self.later, self.delay, self.looks = list(now), list(later), delay, 0
+        self.lingering = set(lingering)  # names listed without any endpoint
 
     def get_publishers_info_by_topic(self, topic: str) -> list[Info]:
         return list(self.now)
@@ -37,7 +40,8 @@ class Graph:
         if self.looks > self.delay:
             self.now += self.later
             self.later = []
-        return {info.node_name for info in self.now} | {"sim_world", "autograder_probe"}
+        return ({info.node_name for info in self.now} | self.lingering
+                | {"sim_world", "autograder_probe"})
 
 
 class World:
@@ -81,7 +85,19 @@ def test_a_restart_waits_for_the_new_instance_not_the_lingering_one():
     assert all(world.held_while_waiting) and not world.holding
 
 
-def test_a_first_start_is_done_when_the_name_appears():
+def test_a_lingering_name_without_endpoints_is_not_the_new_instance():
+    # Seen in a stress run: the earlier instance's endpoints were gone, its name was not,
+    # and a wait that took the name found the node 2 ms after the start.
+    graph = Graph([], [Info(NAME, b"new")], delay=4, lingering={NAME})
+    world = World()
+    stale = _node_endpoints(SimpleNamespace(node=graph), NAME)
+    assert stale == set() and NAME in graph.names()
+    start(graph, world, stale)
+    assert len(world.held_while_waiting) == 4  # the look that showed the new publishers
+    assert all(world.held_while_waiting) and not world.holding
+
+
+def test_a_first_start_is_done_when_its_publishers_appear():
     graph, world = Graph([], [Info(NAME, b"first")], delay=2), World()
     node = start(graph, world, stale=set())
     assert len(world.held_while_waiting) == 3  # done on the look that found it
