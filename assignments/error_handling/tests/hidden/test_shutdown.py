@@ -35,8 +35,9 @@ def _trial(probe, start_node, sig: signal.Signals, trial: int) -> None:
     if not probe.wait_for(lambda: bool(commands.messages) and not is_zero(commands.messages[-1]),
                           5.0):
         raise StudentFailure(
-            _("A fresh node never published a moving command within 5 s, so its shutdown "
-              "could not be judged."),
+            _("A fresh node (trial {trial} of {trials}) never published a moving command "
+              "within 5 s, so its shutdown could not be judged.").format(
+                trial=trial, trials=TRIALS),
             _("Drive forward at 0.2 m/s when the way ahead is clear."))
     node.send_signal(sig)
     code = node.wait_exit(EXIT_WITHIN)
