@@ -550,12 +550,10 @@ def _wait_for_node(exercise: Any, node: StudentNode, world: Any, stale: set[byte
     start-up is then the same in simulation time however long the machine takes (imports,
     discovery), and the node's first tick is the next one."""
     deadline = time.monotonic() + exercise.startup_timeout
-    seen: set[str] = set()
     found = False
 
     def ready() -> bool:
-        nonlocal seen, found
-        seen = node.probe.node_names()
+        nonlocal found
         # Not the name: an earlier instance's may linger after its endpoints are gone.
         found = bool(_node_endpoints(node.probe, exercise.node) - stale)
         return found or not node.running() or time.monotonic() > deadline
@@ -577,7 +575,7 @@ def _wait_for_node(exercise: Any, node: StudentNode, world: Any, stale: set[byte
                 tail=tail or _("(no output)")),
             _("Run it yourself with `python {file} --ros-args -p use_sim_time:=true` and "
               "read the traceback.").format(file=exercise.file))
-    others = sorted(seen - {"autograder_probe", "sim_world"})
+    others = sorted(node.probe.node_names() - {"autograder_probe", "sim_world"})
     node.stop()
     raise NodeNeverAppeared(
         _("No node named '{node}' appeared on the ROS graph within {seconds:.0f} s "

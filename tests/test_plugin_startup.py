@@ -25,7 +25,7 @@ class Info:
 
 
 class Graph:
-    """What the probe's node sees; ``later`` joins after ``delay`` looks at the graph."""
+    """What the probe's node sees; ``later`` joins after ``delay`` of the world's checks."""
 
     def __init__(self, now: list[Info], later: list[Info] = (), delay: int = 0,
                  lingering: set[str] = frozenset()) -> None:
@@ -35,17 +35,20 @@ class Graph:
     def get_publishers_info_by_topic(self, topic: str) -> list[Info]:
         return list(self.now)
 
-    def names(self) -> set[str]:
+    def look(self) -> None:
         self.looks += 1
         if self.looks > self.delay:
             self.now += self.later
             self.later = []
+
+    def names(self) -> set[str]:
         return ({info.node_name for info in self.now} | self.lingering
                 | {"sim_world", "autograder_probe"})
 
 
 class World:
-    def __init__(self) -> None:
+    def __init__(self, graph: Graph) -> None:
+        self.graph = graph
         self.holding = False
         self.held_while_waiting: list[bool] = []
 
@@ -60,6 +63,7 @@ class World:
     def wait_for(self, predicate: Callable[[], bool], sim_timeout: float,
                  wall_timeout: float) -> bool:
         for _ in range(1000):
+            self.graph.look()
             self.held_while_waiting.append(self.holding)
             if predicate():
                 return True
@@ -77,7 +81,8 @@ def start(graph: Graph, world: World, stale: set[bytes]) -> StudentNode:
 
 def test_a_restart_waits_for_the_new_instance_not_the_lingering_one():
     old, new = Info(NAME, b"old"), Info(NAME, b"new")
-    graph, world = Graph([old], [new], delay=5), World()
+    graph = Graph([old], [new], delay=5)
+    world = World(graph)
     stale = _node_endpoints(SimpleNamespace(node=graph), NAME)
     assert stale == {b"old"}
     start(graph, world, stale)
@@ -88,8 +93,8 @@ def test_a_restart_waits_for_the_new_instance_not_the_lingering_one():
 def test_a_lingering_name_without_endpoints_is_not_the_new_instance():
     # Seen in a stress run: the earlier instance's endpoints were gone, its name was not,
     # and a wait that took the name found the node 2 ms after the start.
-    graph = Graph([], [Info(NAME, b"new")], delay=4, lingering={NAME})
-    world = World()
+    graph = Graph([], [Info(NAME, b"new")], delay=3, lingering={NAME})
+    world = World(graph)
     stale = _node_endpoints(SimpleNamespace(node=graph), NAME)
     assert stale == set() and NAME in graph.names()
     start(graph, world, stale)
@@ -98,7 +103,8 @@ def test_a_lingering_name_without_endpoints_is_not_the_new_instance():
 
 
 def test_a_first_start_is_done_when_its_publishers_appear():
-    graph, world = Graph([], [Info(NAME, b"first")], delay=2), World()
+    graph = Graph([], [Info(NAME, b"first")], delay=2)
+    world = World(graph)
     node = start(graph, world, stale=set())
     assert len(world.held_while_waiting) == 3  # done on the look that found it
     assert node.startup_seconds is not None
