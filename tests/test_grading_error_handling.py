@@ -9,6 +9,8 @@ grading is a whole one; they run four at a time, on their own ROS domains.
 
 from __future__ import annotations
 
+import re
+
 import pytest
 from proving import (  # noqa: F401 - the standard checks, collected here
     Proof,
@@ -47,7 +49,12 @@ def test_a_dead_or_silent_node_is_named_as_such(graded):
 
 
 def test_shutdown_failure_shows_the_traceback(graded):
+    """The failure names the trial that went wrong and shows the student's traceback.
+
+    Which trial fails is not fixed: the naive design races rclpy's own signal thread,
+    and now and then (1 in 30 under load, measured) its publish in `finally` wins.
+    """
     by_name = {t.name: t for t in graded["traceback_on_sigint"].tests}
     message = by_name["test_clean_exit_on_sigint"].message
-    assert "trial 1 of 3" in message
+    assert re.search(r"After SIGINT \(trial [123] of 3\)", message), message
     assert "Traceback" in message
