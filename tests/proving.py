@@ -46,7 +46,7 @@ class Proof:
 
 
 def failed_tests(result: RunResult) -> set[str]:
-    return {t.name for t in result.tests if t.status != "passed"}
+    return set(failures(result))
 
 
 def failures(result: RunResult) -> dict[str, str]:
