@@ -21,12 +21,12 @@ from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
+from autograder.cgroups import Cgroup
 from autograder.domains import reserve_domain
 from autograder.exercise import Exercise
 from autograder.i18n import _, get_language
 from autograder.isolation import dds_env, detect, run_prefix, student_uid
 from autograder.results import RunResult, TestResult, exact
-from autograder.sandbox import Cgroup
 from autograder.signing import Forged, verify
 
 GRADER_FAULT = "the autograder failed, tell your instructor"
