@@ -56,8 +56,10 @@ def student_uid(domain: int) -> int:
 
 @functools.cache
 def detect() -> Isolation:
-    """Strict isolation if we are root, namespaces work, and an unprivileged user can run
-    this Python and import rclpy (a venv under /root, mode 0700, is out of its reach)."""
+    """Strict isolation if we are root, namespaces work, and a test program started the
+    way every student's program is (:func:`autograder.sandbox.student_process`, in the
+    run's namespaces) runs Python and rclpy as a user of its own: if the check passes,
+    launches work; if not, basic isolation is used and the reason is kept."""
     if os.environ.get("AUTOGRADER_ISOLATION") == "basic":
         return Isolation(False, N_("basic isolation was asked for (AUTOGRADER_ISOLATION)"))
     if os.geteuid() != 0:
@@ -65,17 +67,61 @@ def detect() -> Isolation:
     unshare = shutil.which("unshare")
     if unshare is None:
         return Isolation(False, N_("the unshare command (util-linux) is missing"))
-    probe = subprocess.run(
-        [unshare, "--net", "--mount", "--propagation", "private", "--", sys.executable,
-         "-m", "autograder.sandbox_exec", "--check", str(student_uid(0))],
-        capture_output=True, text=True, timeout=60,
-        env=dict(os.environ, PYTHONPATH=_package_parent()))
+    try:
+        probe = subprocess.run(
+            [*run_prefix(Isolation(True)), sys.executable, "-m", "autograder.isolation"],
+            capture_output=True, text=True, timeout=120,
+            env=dict(os.environ, PYTHONPATH=_package_parent()))
+    except subprocess.TimeoutExpired:
+        return Isolation(False, N_("a test program could not run in strict isolation"),
+                         "no answer within 120 s")
     if probe.returncode != 0:
-        detail = (probe.stderr or probe.stdout).strip().splitlines()
-        return Isolation(False, N_("an unprivileged user cannot run this Python and rclpy "
-                                   "(make the virtual environment readable by all)"),
-                         detail[-1] if detail else "")
+        detail = (probe.stdout + probe.stderr).strip().splitlines()
+        return Isolation(False, N_("a test program could not run in strict isolation"),
+                         " / ".join(detail[-3:]))
     return Isolation(True)
+
+
+# What the start-up check's test program runs: Python, rclpy and its middleware.
+PROBE_PROGRAM = """\
+import os
+import rclpy
+
+rclpy.init()
+rclpy.shutdown()
+print("autograder-probe-ok", os.getuid())
+"""
+
+
+def probe_launch() -> str | None:
+    """Start a test program exactly as a student's is started in strict isolation; None if
+    it ran as its own user, else what went wrong. Runs inside the run's namespaces."""
+    import tempfile
+
+    from autograder.exercise import Limits
+    from autograder.sandbox import LaunchFailed, student_process
+
+    bring_up_loopback()
+    with tempfile.TemporaryDirectory(prefix="autograder-probe-") as tmp:
+        script = Path(tmp) / "staged" / "probe.py"
+        script.parent.mkdir()
+        script.write_text(PROBE_PROGRAM)
+        process = student_process(script, [], Limits(), domain=0, strict=True,
+                                  course=Path(_package_parent()))
+        try:
+            process.start()
+        except LaunchFailed as exc:
+            return str(exc)
+        try:
+            status = process.wait(60.0)
+        finally:
+            process.stop(grace=1.0)
+            shutil.rmtree(process.workdir, ignore_errors=True)
+        expected = f"autograder-probe-ok {student_uid(0)}"
+        if status == 0 and expected in process.output_text():
+            return None
+        return (f"the test program exited with status {status}: "
+                f"{process.output_tail(3) or '(no output)'}")
 
 
 def _package_parent() -> str:
@@ -116,3 +162,10 @@ def protected_paths(course: Path) -> list[Path]:
     roots = dict.fromkeys((course.resolve(), Path(_package_parent())))
     return [p for root in roots for p in (root / "assignments", root / "tests", root / ".git",
                                           root / "quizzes") if p.exists()]
+
+
+if __name__ == "__main__":
+    problem = probe_launch()
+    if problem is not None:
+        print(problem)
+        sys.exit(1)

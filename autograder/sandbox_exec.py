@@ -4,13 +4,18 @@ Runs as a fresh single-threaded process (so no ``preexec_fn`` runs in the thread
 grader) and ``exec``s the student's command once it is contained::
 
     python -m autograder.sandbox_exec SPEC_JSON -- COMMAND...
-    python -m autograder.sandbox_exec --check UID      # can UID run Python and rclpy?
 
-SPEC holds ``limits`` (see ``autograder.exercise.Limits``) and ``cgroups`` (folders to
-join), and for strict isolation ``uid``, ``hide`` (paths to cover with an empty read-only
-filesystem), ``workdir`` and ``workdir_mb`` (a tmpfs of that size, owned by ``uid``,
-filled with the files staged there).  Strict steps need root; the mounts happen in a
-mount namespace of the student's own, so the grader keeps its view.
+SPEC holds ``limits`` (see ``autograder.exercise.Limits``), ``cgroups`` (folders to
+join) and ``status_fd``, and for strict isolation ``uid``, ``hide`` (paths to cover with
+an empty read-only filesystem), ``workdir`` and ``workdir_mb`` (a tmpfs of that size,
+owned by ``uid``, filled with the files staged there).  Strict steps need root; the
+mounts happen in a mount namespace of the student's own, so the grader keeps its view.
+
+``status_fd`` is the write end of a pipe, close-on-exec, as :mod:`subprocess` does it: if
+anything fails before the student's program is exec'd (a mount, a cgroup, setuid, a
+missing interpreter), the launcher writes what failed there and exits; if the exec
+succeeds the pipe closes with nothing written.  The grader can thus never take a failure
+of ours for the student's program exiting.
 """
 
 from __future__ import annotations
@@ -31,7 +36,9 @@ _RLIMITS = {
 }
 CLONE_NEWNS = 0x00020000
 MS_RDONLY, MS_NOSUID, MS_NODEV, MS_NOEXEC = 1, 2, 4, 8
-MS_REC, MS_PRIVATE = 0x4000, 1 << 18
+MS_REMOUNT, MS_BIND, MS_REC, MS_PRIVATE = 32, 4096, 0x4000, 1 << 18
+# Exit status of a launcher that failed before the exec (what failed is on the status pipe).
+LAUNCH_FAILED = 121
 
 
 def apply_limits(limits: dict[str, int]) -> None:
@@ -112,14 +119,53 @@ def hide_all_but(needed: list[str]) -> None:
     walk("/")
 
 
-def fill_workdir(workdir: str, size_mb: int, uid: int) -> None:
-    """Give the student fresh, empty ``/tmp`` and ``/dev/shm`` (other runs' files, stray
-    copies of a course), and in it ``workdir``: a tmpfs of ``size_mb`` owned by ``uid``,
-    holding the files staged there."""
+def _barrier(path: str) -> str | None:
+    """The topmost folder above ``path`` that the student would not get through: ``/tmp``
+    and ``/dev/shm`` (replaced by fresh ones), or one closed to other users (``/root``)."""
+    parts = Path(path).parts
+    for depth in range(2, len(parts) + 1):
+        folder = str(Path(*parts[:depth]))
+        if folder in FRESH or not os.stat(folder).st_mode & 0o001:
+            return folder
+    return None
+
+
+def _bind_read_only(fd: int, target: str) -> None:
+    os.makedirs(target, mode=0o755, exist_ok=True)
+    _mount(f"/proc/self/fd/{fd}", target, None, MS_BIND | MS_REC, None)
+    _mount("none", target, None, MS_REMOUNT | MS_BIND | MS_RDONLY | MS_NOSUID | MS_NODEV,
+           None)
+
+
+# Shared scratch folders the student gets fresh and empty: other runs' files, stray
+# copies of a course (a clone in /tmp) are not in reach.
+FRESH = ("/tmp", "/dev/shm")
+
+
+def fill_workdir(workdir: str, size_mb: int, uid: int, needed: list[str]) -> None:
+    """Give the student fresh, empty ``/tmp`` and ``/dev/shm``, and in it ``workdir``: a
+    tmpfs of ``size_mb`` owned by ``uid``, holding the files staged there.
+
+    What the program runs on (``needed``: the interpreter, the venv) stays reachable,
+    read-only, also where it lies under ``/tmp`` or under a folder closed to other users:
+    that folder is replaced by an empty one holding only what is needed, bound in."""
     staged = {p.name: p.read_bytes() for p in Path(workdir).iterdir() if p.is_file()}
-    for shared in ("/tmp", "/dev/shm"):
-        if os.path.isdir(shared):
-            _mount("tmpfs", shared, "tmpfs", MS_NOSUID | MS_NODEV, "size=1m,mode=1777")
+    barriers: dict[str, list[str]] = {folder: [] for folder in FRESH if os.path.isdir(folder)}
+    for path in dict.fromkeys(os.path.realpath(p) for p in needed):
+        barrier = _barrier(path)
+        if barrier is not None:
+            barriers.setdefault(barrier, []).append(path)
+    # Reach each needed folder before anything covers it; bind it back afterwards.
+    paths = sorted(p for group in barriers.values() for p in group)
+    outermost = [p for p in paths if not any(p.startswith(q + os.sep) for q in paths)]
+    held = {path: os.open(path, os.O_PATH | os.O_DIRECTORY) for path in outermost}
+    os.umask(0o022)
+    for barrier in sorted(barriers, key=len):
+        mode = "1777" if barrier in FRESH else "0755"
+        _mount("tmpfs", barrier, "tmpfs", MS_NOSUID | MS_NODEV, f"size=1m,mode={mode}")
+    for path, fd in held.items():
+        _bind_read_only(fd, path)
+        os.close(fd)
     os.makedirs(workdir, exist_ok=True)
     _mount("tmpfs", workdir, "tmpfs", MS_NOSUID | MS_NODEV,
            f"size={size_mb}m,mode=0700,uid={uid},gid={uid}")
@@ -139,33 +185,58 @@ def become(uid: int) -> None:
     os.setuid(uid)
 
 
-def main(argv: list[str]) -> None:
-    if argv[:1] == ["--check"]:
-        private_mounts()
-        become(int(argv[1]))
-        os.chdir("/")
-        os.execv(sys.executable, [sys.executable, "-c", "import rclpy"])
-    split = argv.index("--")
-    spec = json.loads(argv[0])
+def interpreter_paths() -> list[str]:
+    """What a Python program needs to run here: the interpreter and its environment."""
+    return [sys.prefix, sys.base_prefix, sys.exec_prefix,
+            os.path.dirname(os.path.realpath(sys.executable))]
+
+
+def contain(spec: dict, stage: list[str]) -> None:
+    """Every step between the grader and the student's program, naming each in ``stage``."""
     uid = spec.get("uid")
     if uid is not None:
+        stage[0] = "mount namespace"
         private_mounts()
+        stage[0] = "hiding the course"
         hide(spec.get("hide", []))
-        hide_all_but([sys.prefix, sys.base_prefix, sys.exec_prefix,
-                      os.path.dirname(os.path.realpath(sys.executable)), spec["workdir"]])
-        fill_workdir(spec["workdir"], int(spec.get("workdir_mb", 64)), uid)
+        hide_all_but([*interpreter_paths(), spec["workdir"]])
+        stage[0] = "working directory"
+        fill_workdir(spec["workdir"], int(spec.get("workdir_mb", 64)), uid,
+                     interpreter_paths())
+    stage[0] = "cgroup"
     for cgroup in spec.get("cgroups", []):
         with open(os.path.join(cgroup, "cgroup.procs"), "w") as fh:
             fh.write(str(os.getpid()))
+    stage[0] = "resource limits"
     limits = dict(spec.get("limits", {}))
     if uid is not None:
         limits["uid"] = uid
     apply_limits(limits)
     if uid is not None:
+        stage[0] = "switching to the student's user"
         become(uid)
         os.chdir(spec["workdir"])
+
+
+def main(argv: list[str]) -> None:
+    split = argv.index("--")
+    spec = json.loads(argv[0])
+    status_fd = spec.get("status_fd")
+    if status_fd is not None:
+        os.set_inheritable(status_fd, False)  # closed by a successful exec, not before
+    stage = ["start"]
     command = argv[split + 1:]
-    os.execvp(command[0], command)
+    try:
+        contain(spec, stage)
+        stage[0] = f"exec {command[0]}"
+        os.execvp(command[0], command)
+    except BaseException as exc:  # noqa: BLE001 - every failure before the exec is ours
+        report = json.dumps({"stage": stage[0], "error": f"{type(exc).__name__}: {exc}"})
+        if status_fd is None:
+            print(report, file=sys.stderr)
+        else:
+            os.write(status_fd, report.encode())
+        os._exit(LAUNCH_FAILED)
 
 
 if __name__ == "__main__":
