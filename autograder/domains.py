@@ -1,46 +1,176 @@
 """ROS domain ids for concurrent grading runs, coordinated through lock files.
 
 Every grading run holds an exclusive ``flock`` on ``domain-<id>.lock`` for as long as it
-runs, so two runs on one machine (``grade-batch --jobs N``, two CI jobs) never share a
-graph.  The kernel drops a lock when its holder dies, so a crashed run frees its domain.
+runs, so two runs on one machine (``grade-batch --jobs N``, two CI jobs, two students on
+a lab PC) never share a graph.  The kernel drops a lock when its last holder dies, so a
+crashed run frees its domain; the run's pytest child inherits the lock's descriptor and
+holds the domain as long as it lives, even past its parent.
+
+The lock folder (``AUTOGRADER_LOCK_DIR``, default ``/tmp/autograder-domains``) is shared
+by every user of the machine: made sticky and world-writable like ``/tmp`` itself, with
+lock files anyone may lock (``flock`` needs only a descriptor opened for reading, so a
+file another user created, whatever their umask, still works).  Where the shared folder
+cannot be used (made by an older version, or a read-only ``/tmp``), each user falls back
+to a folder of their own; other users' runs are then avoided by looking at the wire: a
+domain whose Fast DDS ports have a socket bound on this machine is taken.
 """
 
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import fcntl
 import os
+import stat
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from pathlib import Path
+
+from autograder.errors import GraderError
 
 # Domains 0-9 are left to people running nodes by hand; with Linux's default ephemeral
 # port range, ids up to 101 are safe for Fast DDS.
 FIRST_DOMAIN, LAST_DOMAIN = 10, 101
+# Fast DDS (RTPS) ports: domain d uses PORT_BASE + DOMAIN_GAIN * d and the 250 above it.
+PORT_BASE, DOMAIN_GAIN = 7400, 250
 
 
-def lock_dir() -> Path:
-    path = Path(os.environ.get("AUTOGRADER_LOCK_DIR", Path(tempfile.gettempdir())
-                               / "autograder-domains"))
-    path.mkdir(parents=True, exist_ok=True)
-    return path
+class NoDomain(GraderError):
+    """No ROS domain could be reserved for a grading run."""
+
+
+@dataclasses.dataclass(frozen=True)
+class DomainLock:
+    """A reserved domain and the open lock files that hold it (inheritable by a child)."""
+
+    domain: int
+    fds: tuple[int, ...]
+
+
+def shared_lock_dir() -> Path:
+    return Path(os.environ.get("AUTOGRADER_LOCK_DIR",
+                               Path(tempfile.gettempdir()) / "autograder-domains"))
+
+
+def _usable_shared(folder: Path) -> bool:
+    """Make ``folder`` a sticky world-writable folder if we may; True if we can lock in it."""
+    try:
+        folder.mkdir(mode=0o1777, parents=True, exist_ok=True)
+    except OSError:
+        return False
+    try:
+        info = folder.stat()
+        if info.st_uid == os.geteuid() and stat.S_IMODE(info.st_mode) != 0o1777:
+            os.chmod(folder, 0o1777)  # mkdir's mode went through the umask
+    except OSError:
+        pass
+    return os.access(folder, os.W_OK | os.X_OK)
+
+
+def lock_dirs() -> tuple[Path, Path | None]:
+    """Where runs lock their domains: the shared folder, or where this user cannot use it,
+    a folder of this user's own (and the shared one's existing locks, as far as readable)."""
+    shared = shared_lock_dir()
+    if _usable_shared(shared):
+        return shared, None
+    own = shared.with_name(f"{shared.name}-{os.geteuid()}")
+    own.mkdir(mode=0o700, parents=True, exist_ok=True)
+    return own, (shared if shared.is_dir() else None)
+
+
+def _open_lock(path: Path) -> int | None:
+    """A descriptor on ``path`` to flock, creating it readable and writable by all; None
+    where it cannot be had. Never O_CREAT on another user's file: in a sticky folder the
+    kernel refuses that (``fs.protected_regular``)."""
+    for _attempt in range(3):
+        try:
+            return os.open(path, os.O_RDONLY | os.O_CLOEXEC)
+        except FileNotFoundError:
+            pass
+        except OSError:
+            return None
+        try:
+            fd = os.open(path, os.O_RDONLY | os.O_CREAT | os.O_EXCL | os.O_CLOEXEC, 0o666)
+        except FileExistsError:
+            continue  # another run made it just now: open theirs
+        except OSError:
+            return None
+        with contextlib.suppress(OSError):
+            os.fchmod(fd, 0o666)  # whatever the umask: any user may open it
+        return fd
+    return None
+
+
+def busy_on_the_wire(domain: int, tables: Iterable[str] = ("/proc/net/udp",
+                                                            "/proc/net/udp6")) -> bool:
+    """True if a UDP socket on this machine (this network namespace) is bound to one of
+    the domain's Fast DDS ports: someone is on that domain, locks or not."""
+    low = PORT_BASE + DOMAIN_GAIN * domain
+    for table in tables:
+        try:
+            lines = Path(table).read_text().splitlines()[1:]
+        except OSError:
+            continue
+        for line in lines:
+            fields = line.split()
+            if len(fields) > 1 and low <= int(fields[1].rsplit(":", 1)[1], 16) < low + DOMAIN_GAIN:
+                return True
+    return False
+
+
+TAKEN = -1  # another run holds the lock
+UNAVAILABLE = -2  # the lock file cannot be had (a folder we may not write)
+
+
+def _lock(folder: Path, domain: int) -> int:
+    """A descriptor holding ``domain``'s lock in ``folder``, or TAKEN, or UNAVAILABLE."""
+    fd = _open_lock(folder / f"domain-{domain}.lock")
+    if fd is None:
+        return UNAVAILABLE
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        os.close(fd)
+        return TAKEN
+    return fd
+
+
+def _take(domain: int, own: Path, shared: Path | None) -> DomainLock | None:
+    """Lock ``domain`` in our folder (and in the shared one, where its file can still be
+    opened); None if anyone holds it or a program uses its ports."""
+    held = [_lock(own, domain)]
+    if shared is not None:
+        held.append(_lock(shared, domain))
+    fds = tuple(fd for fd in held if fd >= 0)
+    if held[0] < 0 or TAKEN in held or busy_on_the_wire(domain):
+        for fd in fds:
+            os.close(fd)
+        return None
+    return DomainLock(domain, fds)
+
+
+@contextlib.contextmanager
+def hold_domain(preferred: int | None = None) -> Iterator[DomainLock]:
+    """Hold a free ROS domain for the ``with`` block; :class:`NoDomain` if none is free."""
+    candidates = [preferred] if preferred is not None else range(FIRST_DOMAIN, LAST_DOMAIN + 1)
+    own, shared = lock_dirs()
+    for domain in candidates:
+        lock = _take(domain, own, shared)
+        if lock is None:
+            continue
+        try:
+            yield lock
+        finally:
+            for fd in lock.fds:
+                os.close(fd)  # the lock drops when the last holder (a child too) closes
+        return
+    raise NoDomain(f"no free ROS domain id among {candidates[0]}-{candidates[-1]} "
+                   f"(lock folder {own}): each is locked by another run or its ports are "
+                   f"in use on this machine")
 
 
 @contextlib.contextmanager
 def reserve_domain(preferred: int | None = None) -> Iterator[int]:
     """Hold a free ROS domain id for the duration of the ``with`` block."""
-    candidates = [preferred] if preferred is not None else range(FIRST_DOMAIN, LAST_DOMAIN + 1)
-    for domain in candidates:
-        fd = os.open(lock_dir() / f"domain-{domain}.lock", os.O_CREAT | os.O_RDWR, 0o666)
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            os.close(fd)
-            continue
-        try:
-            yield domain
-        finally:
-            fcntl.flock(fd, fcntl.LOCK_UN)
-            os.close(fd)
-        return
-    raise RuntimeError(f"no free ROS domain id in {list(candidates)}")
+    with hold_domain(preferred) as lock:
+        yield lock.domain

@@ -21,12 +21,12 @@ from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
-from autograder.cgroups import Cgroup
-from autograder.domains import reserve_domain
+from autograder.domains import DomainLock, NoDomain, hold_domain
 from autograder.exercise import Exercise
 from autograder.i18n import _, get_language
-from autograder.isolation import dds_env, detect, run_prefix, student_uid
+from autograder.isolation import Isolation, dds_env, detect, run_prefix, student_uid
 from autograder.results import RunResult, TestResult, exact
+from autograder.sandbox import reap_recorded
 from autograder.signing import Forged, verify
 
 GRADER_FAULT = "the autograder failed, tell your instructor"
@@ -43,10 +43,34 @@ def grade(exercise: Exercise, submission: Path | None, *, hidden: bool = True,
     """
     started = time.monotonic()
     isolation = detect()
+    try:
+        with hold_domain(domain) as lock:
+            result, report = _run(exercise, submission, hidden, lock, isolation,
+                                  real_time_factor, progress, started)
+    except NoDomain as exc:
+        return _fault(exercise, str(exc), time.monotonic() - started)
+    processes = report.get("data", {}).get("processes", [])
+    bounds = processes[0].get("bounds") if processes else None
+    return dataclasses.replace(result, data={
+        **result.data, "isolation": {**isolation.to_dict(), "bounds": bounds},
+        "domain": lock.domain, "processes": processes,
+        "student_uid": student_uid(lock.domain) if isolation.strict else None})
+
+
+def _run(exercise: Exercise, submission: Path | None, hidden: bool, lock: DomainLock,
+         isolation: Isolation, real_time_factor: float | None,
+         progress: Callable[[dict[str, Any]], None] | None,
+         started: float) -> tuple[RunResult, dict[str, Any]]:
+    """One grading in a child pytest on the reserved domain; the result and raw report.
+
+    The child inherits the domain's lock (it holds the domain as long as it lives) and the
+    read end of a *lifeline* pipe whose write end only this process holds: when this
+    process dies, however it dies, the child sees the pipe close and ends itself and every
+    student process it started (see ``autograder.pytest_plugin``)."""
     folders = [exercise.public_tests] + ([exercise.hidden_tests] if hidden else [])
     folders = [f for f in folders if f.is_dir()]
-    with tempfile.TemporaryDirectory(prefix="autograder-") as tmp, \
-            reserve_domain(domain) as ros_domain:
+    ros_domain = lock.domain
+    with tempfile.TemporaryDirectory(prefix="autograder-") as tmp:
         report_path = Path(tmp) / "report.json"
         command = [
             *run_prefix(isolation), sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
@@ -69,24 +93,36 @@ def grade(exercise: Exercise, submission: Path | None, *, hidden: bool = True,
         log_path = Path(tmp) / "pytest.log"
         key = secrets.token_bytes(32)
         key_read, key_write = os.pipe()
-        command += ["--autograder-report-key-fd", str(key_read)]
-        with log_path.open("wb") as log:
-            child = subprocess.Popen(command, cwd=tmp, env=env, stdout=log,
-                                     stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
-                                     start_new_session=True, pass_fds=(key_read,))
-            os.close(key_read)
-            with os.fdopen(key_write, "wb") as pipe:
-                pipe.write(key)
-            timed_out = _wait(child, exercise.time_limit, report_path, key, progress)
+        life_read, life_write = os.pipe()
+        command += ["--autograder-report-key-fd", str(key_read),
+                    "--autograder-lifeline-fd", str(life_read)]
+        try:
+            with log_path.open("wb") as log:
+                child = subprocess.Popen(command, cwd=tmp, env=env, stdout=log,
+                                         stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
+                                         start_new_session=True,
+                                         pass_fds=(key_read, life_read, *lock.fds))
+                os.close(key_read)
+                os.close(life_read)
+                with os.fdopen(key_write, "wb") as pipe:
+                    pipe.write(key)
+                timed_out = _wait(child, exercise.time_limit, report_path, key, progress)
+        finally:
+            os.close(life_write)
         report = _read_report(report_path, key)
         _reap(child, report)
         pytest_log = log_path.read_text(errors="replace")
     result = _result(exercise, report, child.returncode, timed_out, pytest_log,
                      time.monotonic() - started, all_tests=hidden)
-    return dataclasses.replace(result, data={
-        **result.data, "isolation": isolation.to_dict(), "domain": ros_domain,
-        "processes": report.get("data", {}).get("processes", []),
-        "student_uid": student_uid(ros_domain) if isolation.strict else None})
+    return result, report
+
+
+def _fault(exercise: Exercise, details: str, elapsed: float) -> RunResult:
+    """A grading that could not run at all: the grader's failure, said plainly."""
+    return RunResult(kind="exercise", id=exercise.id, title=exercise.localized_title,
+                     tests=(), pass_mark=exercise.pass_fraction, lang=get_language(),
+                     grader_error=GRADER_FAULT, grader_details=details,
+                     execution_time=elapsed)
 
 
 def _wait(child: subprocess.Popen[bytes], limit: float, report_path: Path, key: bytes,
@@ -132,13 +168,7 @@ def _reap(child: subprocess.Popen[bytes], report: dict[str, Any]) -> None:
     except (ProcessLookupError, PermissionError):
         pass
     for process in report.get("data", {}).get("processes", []):
-        try:
-            os.killpg(process["pid"], signal.SIGKILL)
-        except (ProcessLookupError, PermissionError):
-            pass
-        group = Cgroup.existing(process.get("cgroups", []))
-        group.kill_all()
-        group.remove()
+        reap_recorded(process)
 
 
 def _score(status: str, max_score: Fraction, fraction: float | None) -> Fraction:

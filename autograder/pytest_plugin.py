@@ -18,7 +18,8 @@ import itertools
 import json
 import os
 import shutil
-import tempfile
+import signal
+import threading
 import time
 import traceback
 from collections.abc import Callable, Iterator
@@ -46,6 +47,9 @@ def pytest_addoption(parser: pytest.Parser) -> None:
                     help="write the raw grading report (JSON) to this file")
     group.addoption("--autograder-report-key-fd", type=int, default=None,
                     help="read the report's signing key from this file descriptor")
+    group.addoption("--autograder-lifeline-fd", type=int, default=None,
+                    help="end this run and its student processes when this pipe closes "
+                         "(the grader that started the run died)")
     group.addoption("--ros-domain", type=int, default=None,
                     help="ROS domain id of this run (default: reserve a free one)")
     group.addoption("--real-time-factor", type=float, default=None,
@@ -75,6 +79,27 @@ def pytest_configure(config: pytest.Config) -> None:
                                    config.getoption("exercise"), key)
         config.stash[reporter_key] = reporter
         config.pluginmanager.register(reporter, "autograder-reporter")
+        lifeline = config.getoption("autograder_lifeline_fd")
+        if lifeline is not None:
+            _watch_lifeline(lifeline, reporter)
+
+
+def _watch_lifeline(fd: int, reporter: GradingReporter) -> None:
+    """When the grader that started this run dies (the pipe's only writer), end every
+    student process of the run and then the run itself: an orphaned run would go on
+    grading on a domain another run may take."""
+
+    def watch() -> None:
+        with contextlib.suppress(OSError):
+            while os.read(fd, 1):
+                pass
+        from autograder.sandbox import reap_recorded
+
+        for process in list(reporter.data["processes"]):
+            reap_recorded(process)
+        os.killpg(os.getpgrp(), signal.SIGKILL)
+
+    threading.Thread(target=watch, daemon=True, name="autograder-lifeline").start()
 
 
 def pytest_unconfigure(config: pytest.Config) -> None:
@@ -129,9 +154,10 @@ class GradingReporter:
         tmp.write_text(sign(payload, self.key))
         tmp.replace(self.path)
 
-    def note_process(self, pid: int, cgroups: list[str]) -> None:
-        """Record a student process so the parent can reap it if this run is killed."""
-        self.data["processes"].append({"pid": pid, "cgroups": cgroups})
+    def note_process(self, pid: int, cgroups: list[str], bounds: dict[str, Any]) -> None:
+        """Record a student process so the parent can reap it if this run is killed, and
+        say which bounds held it."""
+        self.data["processes"].append({"pid": pid, "cgroups": cgroups, "bounds": bounds})
         self.write()
 
     @pytest.hookimpl(trylast=True)
@@ -450,8 +476,7 @@ def launch(request: pytest.FixtureRequest, exercise: Any, script: Path, probe: A
            world: Any, params: dict[str, Any] | None = None,
            wait_for_node: bool = True) -> StudentNode:
     """Start the student's program with ``use_sim_time:=true`` and wait for its node."""
-    from autograder.isolation import dds_env, protected_paths, student_uid
-    from autograder.sandbox import StudentProcess, minimal_env
+    from autograder.sandbox import student_process
 
     source = script.read_text(encoding="utf-8", errors="replace")
     try:
@@ -465,27 +490,19 @@ def launch(request: pytest.FixtureRequest, exercise: Any, script: Path, probe: A
     ros_args = ["-p", "use_sim_time:=true"]
     for key, value in (params or {}).items():
         ros_args += ["-p", f"{key}:={_ros_value(value)}"]
-    strict = _strict()
-    # Strict: a folder outside the grader's (0700) run folder, turned into the student's
-    # own tmpfs by the launcher. Basic: a throwaway folder beside the staged copy.
-    workdir = Path(tempfile.mkdtemp(prefix="autograder-student-" if strict else "student-",
-                                    dir=None if strict else script.parent.parent))
-    for source in script.parent.glob("*.py"):
-        (workdir / source.name).write_bytes(source.read_bytes())
-    domain = int(os.environ["ROS_DOMAIN_ID"])
-    env = minimal_env(workdir, {"ROS_DOMAIN_ID": str(domain), **dds_env(detect_mode())})
-    process = StudentProcess(workdir / script.name, workdir, ros_args, env, exercise.limits)
-    if strict:
-        process.uid = student_uid(domain)
-        process.hide = protected_paths(exercise.folder.parent.parent)
+    process = student_process(script, ros_args, exercise.limits,
+                              domain=int(os.environ["ROS_DOMAIN_ID"]), strict=_strict(),
+                              course=exercise.folder.parent.parent)
     # An earlier instance may still be on the graph: its name until its participant's
     # lease runs out, some of its endpoints too. Only publishers that were not there
     # before the start are this instance's.
     stale = _node_endpoints(probe, exercise.node) if wait_for_node else set()
-    process.start()
     reporter = request.config.stash.get(reporter_key, None)
     if reporter is not None:
-        reporter.note_process(process.pid, [str(p) for p in process.cgroup.paths])
+        process.on_spawn = lambda: reporter.note_process(
+            process.pid, [str(p) for p in process.cgroup.paths],
+            process.cgroup.bounds(separate_uid=process.uid is not None))
+    process.start()
     world.watch_pid(process.pid)
     node = StudentNode(process, exercise.node, probe)
     if wait_for_node:
@@ -501,13 +518,6 @@ def launch(request: pytest.FixtureRequest, exercise: Any, script: Path, probe: A
         if reporter is not None:
             reporter.data.setdefault("startup_seconds", []).append(node.startup_seconds)
     return node
-
-
-def detect_mode() -> Any:
-    """The run's isolation, as the parent chose it (never detected again in here)."""
-    from autograder.isolation import Isolation
-
-    return Isolation(_strict())
 
 
 def _tail_with_size(node: StudentNode) -> str:

@@ -9,24 +9,65 @@ find and kill everything it started, daemons that left the session included.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import json
 import os
+import select
 import signal
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 import uuid
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 from autograder.cgroups import Cgroup
+from autograder.errors import GraderError
 from autograder.exercise import Limits
 
 _PASS_THROUGH = (
     "PATH", "LD_LIBRARY_PATH", "PYTHONPATH", "AMENT_PREFIX_PATH", "ROS_DISTRO", "ROS_VERSION",
     "ROS_PYTHON_VERSION", "RMW_IMPLEMENTATION", "LANG", "LC_ALL", "TZ",
 )
+
+
+def student_process(script: Path, ros_args: list[str], limits: Limits, *, domain: int,
+                    strict: bool, course: Path) -> StudentProcess:
+    """The student's program as every launch prepares it: a copy of ``script`` and its
+    sibling modules in a working directory of its own, a minimal environment on ROS
+    domain ``domain``, and in strict isolation a user of its own with the course hidden.
+
+    The grading (``autograder.pytest_plugin.launch``) and strict isolation's start-up check
+    (``autograder.isolation``) both start programs through here, so the check proves what
+    a real launch does."""
+    from autograder.isolation import Isolation, dds_env, protected_paths, student_uid
+
+    # Strict: a folder outside the grader's (0700) run folder, turned into the student's
+    # own tmpfs by the launcher. Basic: a throwaway folder beside the staged copy.
+    workdir = Path(tempfile.mkdtemp(prefix="autograder-student-" if strict else "student-",
+                                    dir=None if strict else script.parent.parent))
+    for source in script.parent.glob("*.py"):
+        (workdir / source.name).write_bytes(source.read_bytes())
+    env = minimal_env(workdir, {"ROS_DOMAIN_ID": str(domain), **dds_env(Isolation(strict))})
+    process = StudentProcess(workdir / script.name, workdir, ros_args, env, limits)
+    if strict:
+        process.uid = student_uid(domain)
+        process.hide = protected_paths(course)
+    return process
+
+
+def reap_recorded(record: dict[str, Any]) -> None:
+    """Kill a student process known only by its record in the raw report (``pid`` and
+    ``cgroups``), from another process: its process group and everything in its cgroups."""
+    with contextlib.suppress(ProcessLookupError, PermissionError):
+        os.killpg(record["pid"], signal.SIGKILL)
+    group = Cgroup.existing(record.get("cgroups", []))
+    group.kill_all()
+    group.remove()
 
 
 def minimal_env(workdir: Path, extra: dict[str, str | None]) -> dict[str, str]:
@@ -49,6 +90,18 @@ def minimal_env(workdir: Path, extra: dict[str, str | None]) -> dict[str, str]:
         else:
             env[key] = value
     return env
+
+
+class LaunchFailed(GraderError):
+    """The launcher failed before the student's program ran: our fault, never theirs."""
+
+    def __init__(self, stage: str, error: str) -> None:
+        super().__init__(f"the launcher failed at {stage}: {error}")
+        self.stage, self.error = stage, error
+
+
+# Wall seconds the launcher has to contain the program and exec it (mounts, cgroups).
+LAUNCH_TIMEOUT = 60.0
 
 
 class _Output:
@@ -79,6 +132,27 @@ class _Output:
             return bytes(self.head + middle + self.tail).decode("utf-8", "replace")
 
 
+def _read_status(fd: int, timeout: float) -> dict[str, str] | None:
+    """What the launcher reported on its close-on-exec pipe: None once the program was
+    exec'd (end of file, nothing written), else the failed stage and its error."""
+    deadline = time.monotonic() + timeout
+    data = b""
+    while True:
+        ready, _w, _x = select.select([fd], [], [], max(0.0, deadline - time.monotonic()))
+        if not ready:
+            return {"stage": "start", "error": f"no exec within {timeout:.0f} s"}
+        chunk = os.read(fd, 65536)
+        if not chunk:
+            break
+        data += chunk
+    if not data:
+        return None
+    try:
+        return json.loads(data)
+    except ValueError:
+        return {"stage": "?", "error": data.decode(errors="replace")}
+
+
 @dataclasses.dataclass
 class StudentProcess:
     """The student's program, started with ``--ros-args`` like ``ros2 run`` would."""
@@ -96,15 +170,22 @@ class StudentProcess:
     workdir_mb: int = 64
     started_at: float = 0.0
     timed_out: bool = False
+    # Called as soon as the launcher's process exists, before it is contained: whoever
+    # must reap it if the grader dies can know it from the start.
+    on_spawn: Callable[[], None] | None = None
     _reader: threading.Thread | None = None
     _watchdog: threading.Timer | None = None
 
     def start(self) -> None:
+        """Start the program through the launcher; return once it is exec'd, or raise
+        :class:`LaunchFailed` if the launcher failed before that."""
         self.workdir.mkdir(parents=True, exist_ok=True)
         (self.workdir / ".ros" / "log").mkdir(parents=True, exist_ok=True)
         self.cgroup = Cgroup(f"run-{os.getpid()}-{uuid.uuid4().hex[:8]}", self.limits)
+        status_read, status_write = os.pipe()
         spec: dict[str, object] = {"limits": dataclasses.asdict(self.limits),
-                                   "cgroups": [str(p) for p in self.cgroup.paths]}
+                                   "cgroups": [str(p) for p in self.cgroup.paths],
+                                   "status_fd": status_write}
         if self.uid is not None:
             spec.update(uid=self.uid, hide=[str(p) for p in self.hide],
                         workdir=str(self.workdir), workdir_mb=self.workdir_mb)
@@ -115,12 +196,25 @@ class StudentProcess:
         launcher_env["PYTHONPATH"] = os.pathsep.join(
             p for p in (str(Path(__file__).resolve().parent.parent), self.env.get("PYTHONPATH"))
             if p)
-        self.popen = subprocess.Popen(
-            command, cwd=self.workdir, env=launcher_env, stdin=subprocess.DEVNULL,
-            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, start_new_session=True)
+        try:
+            self.popen = subprocess.Popen(
+                command, cwd=self.workdir, env=launcher_env, stdin=subprocess.DEVNULL,
+                stdout=subprocess.PIPE, stderr=subprocess.STDOUT, start_new_session=True,
+                pass_fds=(status_write,))
+        finally:
+            os.close(status_write)
         self.started_at = time.monotonic()
+        if self.on_spawn is not None:
+            self.on_spawn()
         self._reader = threading.Thread(target=self._read, daemon=True, name="student-output")
         self._reader.start()
+        try:
+            failure = _read_status(status_read, LAUNCH_TIMEOUT)
+        finally:
+            os.close(status_read)
+        if failure is not None:
+            self.reap()
+            raise LaunchFailed(failure.get("stage", "?"), failure.get("error", "?"))
         self._watchdog = threading.Timer(self.limits.wall_seconds, self._out_of_time)
         self._watchdog.daemon = True
         self._watchdog.start()

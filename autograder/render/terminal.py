@@ -29,6 +29,28 @@ def test_line(test: TestResult, color: bool = False, reveal: bool = True) -> str
     return line
 
 
+def _bound(kind: str | None, cgroup: str | None, controller: str, rlimit: str) -> str:
+    if kind == "cgroup":
+        return _("the {version} {controller} cgroup").format(version=cgroup,
+                                                             controller=controller)
+    if kind == "rlimit":
+        return rlimit
+    return _("nothing (no writable cgroup, no user of its own)")
+
+
+def isolation_line(isolation: dict) -> str:
+    """How the student's program was contained, and what bounded it, in one line."""
+    bounds = isolation.get("bounds") or {}
+    limits = _("processes bounded by {processes}, memory by {memory}").format(
+        processes=_bound(bounds.get("processes"), bounds.get("cgroup"), "pids", "RLIMIT_NPROC"),
+        memory=_bound(bounds.get("memory"), bounds.get("cgroup"), "memory", "RLIMIT_AS"))
+    if isolation.get("mode") == "strict":
+        return _("Isolation: strict (a user of its own, no network, the course hidden); "
+                 "{limits}.").format(limits=limits)
+    return _("Isolation: basic, {reason}; the program ran as the grader's user; "
+             "{limits}.").format(reason=_(isolation.get("reason", "")), limits=limits)
+
+
 def to_terminal(result: RunResult, color: bool = False, show_details: bool = True) -> str:
     """The whole summary. ``show_details`` adds every failure's full message and hint."""
     lines = [_style(f"{result.id} — {result.title}", None, color, bold=True), ""]
@@ -44,9 +66,8 @@ def to_terminal(result: RunResult, color: bool = False, show_details: bool = Tru
                                 percent=percent, verdict=verdict, mark=mark),
                         "green" if result.passed else "red", color, bold=True))
     isolation = result.data.get("isolation", {})
-    if isolation.get("mode") == "basic":
-        lines.append(_("Isolation: basic, {reason}; the program ran as the grader's user.")
-                     .format(reason=_(isolation.get("reason", ""))))
+    if isolation:
+        lines.append(isolation_line(isolation))
     if result.grader_error:
         lines.append(_style(_("The autograder failed, tell your instructor."), "yellow", color,
                             bold=True))
