@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import csv
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -102,7 +103,52 @@ def test_batch_with_two_jobs_matches_one_by_one(tmp_path, submissions, one_by_on
     assert (out / "student00" / "gradescope.json").exists()
 
 
+def _processes() -> dict[int, tuple[int, str]]:
+    """Every process: pid -> (parent pid, start time), from /proc."""
+    found = {}
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            stat = (entry / "stat").read_text()
+        except OSError:
+            continue
+        fields = stat.rsplit(")", 1)[1].split()
+        found[int(entry.name)] = (int(fields[1]), fields[19])
+    return found
+
+
+def run_folders(processes: set[tuple[int, str]]) -> set[Path]:
+    """The temporary folders of the gradings among ``processes`` (their pytest children)."""
+    found = set()
+    for pid, _start in processes:
+        try:
+            args = Path(f"/proc/{pid}/cmdline").read_bytes().split(b"\0")
+        except OSError:
+            continue
+        if b"--autograder-report" in args:
+            found.add(Path(args[args.index(b"--autograder-report") + 1].decode()).parent)
+    return found
+
+
+def descendants(pid: int) -> set[tuple[int, str]]:
+    """The processes below ``pid`` (with their start times, so a reused pid is not them)."""
+    table = _processes()
+    found, frontier = set(), {pid}
+    while frontier:
+        frontier = {p for p, (parent, _t) in table.items() if parent in frontier}
+        found |= {(p, table[p][1]) for p in frontier}
+    return found
+
+
+def alive(processes: set[tuple[int, str]]) -> set[tuple[int, str]]:
+    table = _processes()
+    return {(p, t) for p, t in processes if p in table and table[p][1] == t}
+
+
 def test_batch_resumes_after_being_killed(tmp_path, submissions, one_by_one, course_env):
+    """Killed with SIGKILL, the batch leaves no grading running (each run's child sees
+    its lifeline close and ends itself and its student processes)."""
     book, out = tmp_path / "gradebook.csv", tmp_path / "reports"
     args = ["shout", str(submissions), "--jobs", "2", "--csv", str(book), "--out", str(out)]
     first = batch(args, course_env)
@@ -110,8 +156,19 @@ def test_batch_resumes_after_being_killed(tmp_path, submissions, one_by_one, cou
     while len(list(out.glob("*/results.json"))) < 4 and time.monotonic() < deadline:
         assert first.poll() is None, first.stdout.read()
         time.sleep(0.2)
+    running = descendants(first.pid)
+    folders = run_folders(running)
+    assert folders, "the batch had no grading running when it was killed"
     os.killpg(first.pid, signal.SIGKILL)
     first.wait()
+    deadline = time.monotonic() + 60
+    while alive(running) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not alive(running), f"left running after the batch was killed: {alive(running)}"
+    for folder in folders:  # the dead batch could not remove them; ended, not finished:
+        log = (folder / "pytest.log").read_text()  # an orphan would have run to its summary
+        assert not re.search(r"\d+ (passed|failed|error)", log), log[-2000:]
+        shutil.rmtree(folder, ignore_errors=True)
     done_before = {p.parent.name for p in out.glob("*/results.json")}
     assert 4 <= len(done_before) < len(KINDS)
     second = batch(args, course_env)

@@ -1,0 +1,103 @@
+"""ROS domains on a machine shared by users: locks any user may take, a clean fallback
+where the shared folder cannot be used, and a domain in use on the wire is never taken."""
+
+from __future__ import annotations
+
+import fcntl
+import os
+import socket
+import subprocess
+import sys
+import tempfile
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+from autograder.domains import (
+    DOMAIN_GAIN,
+    FIRST_DOMAIN,
+    PORT_BASE,
+    NoDomain,
+    busy_on_the_wire,
+    hold_domain,
+    reserve_domain,
+)
+
+REPO = Path(__file__).resolve().parent.parent
+NOBODY = 65534
+as_root = pytest.mark.skipif(os.geteuid() != 0, reason="needs root to run as another user")
+
+# Reserve a domain as another user and print it (or the error, with no traceback).
+OTHER_USER = """
+import sys
+from autograder.domains import NoDomain, hold_domain
+try:
+    with hold_domain() as lock:
+        print("domain", lock.domain)
+except NoDomain as exc:
+    print("no domain", exc)
+"""
+
+
+@pytest.fixture
+def lock_dir(monkeypatch: pytest.MonkeyPatch) -> Iterator[Path]:
+    """A lock folder in a parent like /tmp: sticky, and every user may write there."""
+    parent = Path(tempfile.mkdtemp(prefix="autograder-locks-", dir="/tmp"))
+    os.chmod(parent, 0o1777)
+    folder = parent / "domains"
+    monkeypatch.setenv("AUTOGRADER_LOCK_DIR", str(folder))
+    yield folder
+    subprocess.run(["rm", "-rf", str(parent)], check=False)
+
+
+def _as_nobody(lock_dir: Path) -> str:
+    env = dict(os.environ, AUTOGRADER_LOCK_DIR=str(lock_dir), PYTHONPATH=str(REPO))
+    run = subprocess.run([sys.executable, "-c", OTHER_USER], capture_output=True, text=True,
+                         env=env, user=NOBODY, group=NOBODY, cwd="/", timeout=60)
+    assert run.returncode == 0 and "Traceback" not in run.stderr, run.stderr
+    return run.stdout.strip()
+
+
+@as_root
+def test_another_user_locks_in_the_shared_folder_after_root(lock_dir):
+    old = os.umask(0o077)  # the strictest umask: the files must still be lockable by all
+    try:
+        with hold_domain() as first:
+            assert _as_nobody(lock_dir) == f"domain {first.domain + 1}"
+        assert oct(lock_dir.stat().st_mode & 0o7777) == "0o1777"
+        assert oct((lock_dir / f"domain-{first.domain}.lock").stat().st_mode & 0o777) == "0o666"
+        # Released: the other user may now lock root's file for that domain.
+        assert _as_nobody(lock_dir) == f"domain {first.domain}"
+    finally:
+        os.umask(old)
+
+
+@as_root
+def test_an_unusable_shared_folder_falls_back_to_the_users_own(lock_dir):
+    # As an older version left it: a folder and a lock file only root may write, and a
+    # run of root's holding the first domain.
+    lock_dir.mkdir(mode=0o755)
+    lock_dir.chmod(0o755)
+    held = lock_dir / f"domain-{FIRST_DOMAIN}.lock"
+    held.touch(mode=0o644)
+    with held.open() as fh:
+        fcntl.flock(fh, fcntl.LOCK_EX)
+        # The other user locks in a folder of its own, and still sees root's lock.
+        assert _as_nobody(lock_dir) == f"domain {FIRST_DOMAIN + 1}"
+    own = lock_dir.with_name(f"{lock_dir.name}-{NOBODY}")
+    assert own.is_dir() and own.stat().st_uid == NOBODY
+
+
+def test_a_domain_in_use_on_the_wire_is_skipped(lock_dir):
+    with reserve_domain() as free:
+        pass
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
+        sock.bind(("127.0.0.1", PORT_BASE + DOMAIN_GAIN * free + 11))  # a DDS user port
+        assert busy_on_the_wire(free)
+        with reserve_domain() as domain:
+            assert domain != free
+        with pytest.raises(NoDomain, match="ports are in use"):
+            with reserve_domain(free):
+                pass
+    assert not busy_on_the_wire(free)

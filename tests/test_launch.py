@@ -1,0 +1,122 @@
+"""The launcher between the grader and a student's program: a failure before the exec is
+the grader's, reported as such, never the student's zero; strict isolation works wherever
+the interpreter lives, /tmp included."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+import sysconfig
+import tempfile
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+from autograder.exercise import Limits
+from autograder.grading import GRADER_FAULT
+from autograder.isolation import detect
+from autograder.sandbox import LaunchFailed, student_process
+
+REPO = Path(__file__).resolve().parent.parent
+COURSE = REPO / "tests" / "fixtures" / "mini_course"
+SOLUTION = COURSE / "assignments" / "shout" / "solution"
+
+
+def _program(tmp_path: Path, text: str) -> Path:
+    script = tmp_path / "staged" / "program.py"
+    script.parent.mkdir(parents=True)
+    script.write_text(text)
+    return script
+
+
+def test_a_launch_that_cannot_exec_raises_launch_failed(tmp_path, monkeypatch):
+    monkeypatch.setenv("AUTOGRADER_STUDENT_PYTHON", "/nonexistent/python3")
+    process = student_process(_program(tmp_path, "print('ran')\n"), [], Limits(), domain=0,
+                              strict=False, course=COURSE)
+    with pytest.raises(LaunchFailed) as failure:
+        process.start()
+    assert failure.value.stage == "exec /nonexistent/python3"
+    assert "FileNotFoundError" in failure.value.error
+    assert not process.running()
+    assert "ran" not in process.output_text()
+
+
+def test_a_program_that_fails_at_once_is_the_programs_failure(tmp_path):
+    """Exit status 1 from the program itself is not a launch failure: the exec happened."""
+    process = student_process(_program(tmp_path, "raise SystemExit('mine')\n"), [],
+                              Limits(), domain=0, strict=False, course=COURSE)
+    process.start()  # no LaunchFailed: the pipe closed on exec
+    assert process.wait(30) == 1
+    process.stop()
+    assert "mine" in process.output_text()
+
+
+@pytest.mark.slow
+def test_a_grader_fault_is_exit_3_never_a_students_zero(tmp_path):
+    """With the launcher unable to exec the interpreter, `grade` says the autograder
+    failed (exit 3), marks no test as the student's failure, and still writes results."""
+    env = dict(os.environ, AUTOGRADER_COURSE=str(COURSE),
+               AUTOGRADER_STUDENT_PYTHON="/nonexistent/python3")
+    results = tmp_path / "results.json"
+    run = subprocess.run([sys.executable, "-m", "autograder.cli", "grade", "shout",
+                          str(SOLUTION), "--results", str(results)],
+                         capture_output=True, text=True, env=env, timeout=300)
+    assert run.returncode == 3, run.stdout + run.stderr
+    assert "The autograder failed, tell your instructor." in run.stdout
+    data = json.loads(results.read_text())
+    assert data["grader_error"] == GRADER_FAULT
+    assert {t["status"] for t in data["tests"]} == {"error"}
+    assert "the launcher failed at exec /nonexistent/python3" in run.stdout  # the detail
+
+
+def _venv_under_tmp() -> Path:
+    """A venv in /tmp whose packages are this one's (a .pth file), made in a second."""
+    folder = Path(tempfile.mkdtemp(prefix="autograder-venv-", dir="/tmp"))
+    os.chmod(folder, 0o755)
+    venv = folder / "venv"
+    base = getattr(sys, "_base_executable", sys.executable)
+    subprocess.run([base, "-m", "venv", "--without-pip", str(venv)], check=True)
+    site = Path(sysconfig.get_path("purelib", vars={"base": str(venv)}))
+    (site / "parent.pth").write_text(sysconfig.get_path("purelib") + "\n")
+    return venv
+
+
+@pytest.fixture(scope="module")
+def tmp_setup() -> Iterator[tuple[Path, Path]]:
+    """A venv and a copy of the course, both under /tmp, as a clone in /tmp has them."""
+    if not detect().strict:
+        pytest.skip(f"needs strict isolation: {detect().reason}")
+    venv = _venv_under_tmp()
+    course = Path(tempfile.mkdtemp(prefix="autograder-course-", dir="/tmp")) / "course"
+    shutil.copytree(COURSE, course)
+    os.chmod(course.parent, 0o755)
+    yield venv, course
+    shutil.rmtree(venv.parent, ignore_errors=True)
+    shutil.rmtree(course.parent, ignore_errors=True)
+
+
+def _grade_from(venv: Path, course: Path, submission: Path, out: Path) -> tuple[dict, str]:
+    """Grade with the venv's Python; the results and the JUnit XML (it holds the log)."""
+    env = dict(os.environ, AUTOGRADER_COURSE=str(course), PYTHONPATH=str(REPO))
+    junit = out.with_suffix(".xml")
+    run = subprocess.run([str(venv / "bin" / "python"), "-m", "autograder.cli", "grade",
+                          "shout", str(submission), "--results", str(out), "--junit",
+                          str(junit)], capture_output=True, text=True, env=env, timeout=300)
+    assert run.returncode == 0, run.stdout + run.stderr
+    return json.loads(out.read_text()), junit.read_text()
+
+
+@pytest.mark.slow
+def test_strict_isolation_with_the_venv_and_the_course_under_tmp(tmp_setup, tmp_path):
+    venv, course = tmp_setup
+    data, _log = _grade_from(venv, course, course / "assignments/shout/solution",
+                             tmp_path / "results.json")
+    assert data["isolation"]["mode"] == "strict"
+    assert (data["score"], data["max_score"]) == (3, 3)
+    _data, log = _grade_from(venv, course, REPO / "tests/submissions/hostile/reads_secrets",
+                             tmp_path / "secrets.json")
+    assert "SECRETS FOUND: 0" in log
