@@ -60,6 +60,12 @@ def student_process(script: Path, ros_args: list[str], limits: Limits, *, domain
     return process
 
 
+def student_python() -> str:
+    """The interpreter that runs students' programs: ``AUTOGRADER_STUDENT_PYTHON``, else
+    the grader's own (which has rclpy)."""
+    return os.environ.get("AUTOGRADER_STUDENT_PYTHON") or sys.executable
+
+
 def reap_recorded(record: dict[str, Any]) -> None:
     """Kill a student process known only by its record in the raw report (``pid`` and
     ``cgroups``), from another process: its process group and everything in its cgroups."""
@@ -190,7 +196,7 @@ class StudentProcess:
             spec.update(uid=self.uid, hide=[str(p) for p in self.hide],
                         workdir=str(self.workdir), workdir_mb=self.workdir_mb)
         command = [sys.executable, "-m", "autograder.sandbox_exec", json.dumps(spec), "--",
-                   sys.executable, str(self.script), "--ros-args", *self.ros_args]
+                   student_python(), str(self.script), "--ros-args", *self.ros_args]
         self.output = _Output(self.limits.output_kb * 1024)
         launcher_env = dict(self.env)
         launcher_env["PYTHONPATH"] = os.pathsep.join(

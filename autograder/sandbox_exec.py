@@ -186,9 +186,18 @@ def become(uid: int) -> None:
 
 
 def interpreter_paths() -> list[str]:
-    """What a Python program needs to run here: the interpreter and its environment."""
-    return [sys.prefix, sys.base_prefix, sys.exec_prefix,
-            os.path.dirname(os.path.realpath(sys.executable))]
+    """What the student's Python needs to run here: the interpreter, its environment, and
+    every folder on its module path (a venv's site-packages, a system ROS install's), but
+    not this platform's own checkout, whose way onto the path is the launcher's."""
+    own = os.path.realpath(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    here = os.path.realpath(os.getcwd())
+    found = [sys.prefix, sys.base_prefix, sys.exec_prefix,
+             os.path.dirname(os.path.realpath(sys.executable))]
+    found += [p for p in sys.path if os.path.isabs(p) and os.path.isdir(p)
+              and os.path.realpath(p) not in (own, here)]
+    found += [p for p in os.environ.get("LD_LIBRARY_PATH", "").split(os.pathsep)
+              if os.path.isabs(p) and os.path.isdir(p)]
+    return found
 
 
 def contain(spec: dict, stage: list[str]) -> None:
