@@ -3,10 +3,13 @@ kept output travels once, through files beside the raw report, to the results.""
 
 from __future__ import annotations
 
+import json
+from fractions import Fraction
 from pathlib import Path
 
 import pytest
 
+from autograder.cli import _batch_item, write_outputs
 from autograder.grading import _with_output_log
 from autograder.i18n import set_language
 from autograder.output import (
@@ -16,11 +19,14 @@ from autograder.output import (
     TAIL_LINES,
     clip_line,
     clip_middle,
+    log_beside,
     log_folder,
     message_tail,
     size_note,
 )
 from autograder.pytest_plugin import GradingReporter, StudentNode, _bound
+from autograder.render.html import to_html
+from autograder.results import RunResult, TestResult
 from autograder.sandbox import _Output
 from autograder.signing import verify
 
@@ -85,6 +91,8 @@ def test_a_report_entry_is_bounded():
 
 
 def test_log_names():
+    assert log_beside(Path("out/results.json")) == Path("out/results.log")
+    assert log_beside(Path("out/results.log")) == Path("out/results.log.log")
     assert log_folder(Path("/tmp/x/report.json")) == Path("/tmp/x/report.logs")
 
 
@@ -138,3 +146,36 @@ def test_a_log_changed_after_the_run_is_left_out(tmp_path):
     log = _with_output_log(verify(report.read_text(), KEY), report)["output_log"]
     assert "forged" not in log and "real" not in log
     assert "changed after your program ran" in log
+
+
+def run_result(log: str) -> RunResult:
+    test = TestResult("test_starts", "The node starts", Fraction(0), Fraction(1), "failed",
+                      message="Last lines of its output:\nRuntimeError: the end")
+    return RunResult("exercise", "shout", "Shout", (test,), log_tail="RuntimeError: the end",
+                     log=log)
+
+
+def test_the_log_is_in_the_html_once_and_in_a_file_beside_the_results(tmp_path):
+    log = "==> tests/test_a.py <==\nHEAD <b>\n" + "x" * 1000 + "\nRuntimeError: the end"
+    result = run_result(log)
+    html = to_html(result)
+    assert html.count("HEAD &lt;b&gt;") == 1 and "<details" in html
+    assert "The end of your node" not in html  # the tail is in the log already
+    write_outputs(result, {"results": tmp_path / "results.json", "html": None}, tmp_path)
+    assert (tmp_path / "results.log").read_text() == log
+    assert log not in (tmp_path / "results.json").read_text()
+    assert "HEAD" not in json.dumps(result.to_dict())
+
+
+def test_without_the_whole_log_the_html_shows_the_tail():
+    html = to_html(run_result(""))
+    assert "The end of your node" in html and "<details" not in html
+
+
+def test_a_batch_writes_each_students_log(tmp_path, monkeypatch):
+    monkeypatch.setenv("AUTOGRADER_COURSE", str(Path(__file__).parent / "fixtures" /
+                                                 "mini_course"))
+    _grade, _suffix, extra = _batch_item("shout")
+    extra(run_result("the student's output\n"), tmp_path)
+    assert (tmp_path / "output.log").read_text() == "the student's output\n"
+    assert "the student&#39;s output" in (tmp_path / "report.html").read_text()
