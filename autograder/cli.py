@@ -155,14 +155,20 @@ def _run(exercise: str, submission: Path, hidden: bool, outputs: dict[str, Path 
 
 
 def write_outputs(result, outputs: dict[str, Path | None], folder: Path) -> None:  # noqa: ANN001
-    """Write each requested format of ``result`` (``--results``, ``--html``, ...)."""
+    """Write each requested format of ``result`` (``--results``, ``--html``, ...); with
+    ``--results FILE``, the programs' whole output goes to FILE with suffix ``.log``
+    (``log`` names another file for it)."""
+    from autograder.output import log_beside
     from autograder.render.gradescope import to_gradescope
     from autograder.render.html import to_html
     from autograder.render.jsonfile import to_json
     from autograder.render.junit import to_junit
 
     renderers = {"results": to_json, "gradescope": to_gradescope, "junit": to_junit,
-                 "html": lambda r: to_html(r, folder)}
+                 "html": lambda r: to_html(r, folder), "log": lambda r: r.log}
+    outputs = dict(outputs)
+    if outputs.get("results") is not None and result.kind == "exercise":
+        outputs.setdefault("log", log_beside(outputs["results"]))
     for name, path in outputs.items():
         if path is not None:
             path.parent.mkdir(parents=True, exist_ok=True)
@@ -296,7 +302,8 @@ def _batch_item(item: str):  # noqa: ANN202
     if exercise is not None:
         def extra(result, folder: Path) -> None:  # noqa: ANN001
             write_outputs(result, {"html": folder / "report.html",
-                                   "gradescope": folder / "gradescope.json"}, exercise.folder)
+                                   "gradescope": folder / "gradescope.json",
+                                   "log": folder / "output.log"}, exercise.folder)
 
         return (lambda path: grade(exercise, path)), None, extra
     try:

@@ -25,6 +25,7 @@ from autograder.domains import DomainLock, NoDomain, hold_domain
 from autograder.exercise import Exercise
 from autograder.i18n import _, get_language
 from autograder.isolation import Isolation, dds_env, detect, run_prefix, student_uid
+from autograder.output import digest, log_folder
 from autograder.results import RunResult, TestResult, exact
 from autograder.sandbox import reap_recorded
 from autograder.signing import Forged, verify
@@ -110,6 +111,7 @@ def _run(exercise: Exercise, submission: Path | None, hidden: bool, lock: Domain
         finally:
             os.close(life_write)
         report = _read_report(report_path, key)
+        report = _with_output_log(report, report_path)
         _reap(child, report)
         pytest_log = log_path.read_text(errors="replace")
     result = _result(exercise, report, child.returncode, timed_out, pytest_log,
@@ -159,6 +161,29 @@ def _read_report(path: Path, key: bytes) -> dict[str, Any]:
         return verify(text, key)
     except Forged:
         return {"forged": True}
+
+
+def _with_output_log(report: dict[str, Any], report_path: Path) -> dict[str, Any]:
+    """The report with ``output_log``: every program's kept output, from the files the
+    signed report names (read here, before the run's folder goes)."""
+    entries = report.get("data", {}).get("log_files", [])
+    if not entries:
+        return report
+    folder = log_folder(report_path)
+    parts = [f"==> {entry['test']} <==\n{_read_log(folder, entry)}" for entry in entries]
+    return {**report, "output_log": "\n\n".join(parts)}
+
+
+def _read_log(folder: Path, entry: dict[str, Any]) -> str:
+    """One program's kept output, if the file is the one the report vouches for."""
+    path = folder / Path(entry["file"]).name
+    try:  # the size first: a file swapped for a huge one is not read
+        raw = path.read_bytes() if path.stat().st_size == entry["bytes"] else b""
+    except OSError:
+        raw = b""
+    if digest(raw) != entry["sha256"]:
+        return _("(This output was changed after your program ran, so it is left out.)")
+    return raw.decode("utf-8", "replace")
 
 
 def _reap(child: subprocess.Popen[bytes], report: dict[str, Any]) -> None:
@@ -236,6 +261,7 @@ def _result(exercise: Exercise, report: dict[str, Any], returncode: int | None,
         kind="exercise", id=exercise.id, title=exercise.localized_title, tests=tuple(tests),
         pass_mark=exercise.pass_fraction, lang=get_language(), grader_error=grader_error,
         grader_details=details, log_tail="\n".join(logs.values())[-4000:],
+        log=report.get("output_log", ""),
         execution_time=elapsed,
         data={"recordings": data.get("recordings", {}), "timed_out": timed_out,
               "startup_seconds": data.get("startup_seconds", []),

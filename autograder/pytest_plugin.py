@@ -30,6 +30,19 @@ import pytest
 
 from autograder.errors import GraderError, StudentFailure
 from autograder.i18n import _, set_language
+from autograder.output import (
+    DETAILS_BYTES,
+    LOG_TAIL_BYTES,
+    LOG_TAIL_LINES,
+    MESSAGE_BYTES,
+    TAIL_BYTES,
+    TAIL_LINES,
+    clip_middle,
+    digest,
+    log_folder,
+    message_tail,
+    size_note,
+)
 
 reporter_key = pytest.StashKey["GradingReporter"]()
 credit_key = pytest.StashKey["Credit"]()
@@ -140,7 +153,8 @@ class GradingReporter:
         self.exercise = exercise
         self.key = key
         self.tests: dict[str, dict[str, Any]] = {}
-        self.data: dict[str, Any] = {"logs": {}, "recordings": {}, "processes": []}
+        self.data: dict[str, Any] = {"logs": {}, "log_files": [], "recordings": {},
+                                     "processes": []}
         self.hidden_default = "after_published"
 
     def write(self) -> None:
@@ -153,6 +167,21 @@ class GradingReporter:
                              default=str)
         tmp.write_text(sign(payload, self.key))
         tmp.replace(self.path)
+
+    def keep_log(self, nodeid: str, text: str) -> None:
+        """Keep a stopped program's output: its end in the report, the whole of it (as the
+        sandbox kept it) in a file of its own that the report names with its digest, so
+        the report, re-written after every test, stays small."""
+        self.data["logs"][nodeid] = message_tail(text, LOG_TAIL_LINES, LOG_TAIL_BYTES)
+        if self.path is not None and text:
+            folder = log_folder(self.path)
+            folder.mkdir(exist_ok=True)
+            name = f"{len(self.data['log_files']) + 1:03d}.log"
+            raw = text.encode("utf-8", "replace")
+            (folder / name).write_bytes(raw)
+            self.data["log_files"].append({"test": nodeid, "file": name, "bytes": len(raw),
+                                           "sha256": digest(raw)})
+        self.write()
 
     def note_process(self, pid: int, cgroups: list[str], bounds: dict[str, Any]) -> None:
         """Record a student process so the parent can reap it if this run is killed, and
@@ -209,11 +238,20 @@ class GradingReporter:
                 entry.update(_classify(call.excinfo))
         elif call.when == "teardown" and report.failed and entry["status"] == "passed":
             entry.update(_classify(call.excinfo))
+        _bound(entry)
 
     def pytest_runtest_logfinish(self, nodeid: str) -> None:
         if nodeid in self.tests:
             self.tests[nodeid]["done"] = True
         self.write()
+
+
+def _bound(entry: dict[str, Any]) -> None:
+    """Cut what a test reports to a few KB: every results format repeats it per test."""
+    for key, limit in (("message", MESSAGE_BYTES), ("hint", MESSAGE_BYTES),
+                       ("details", DETAILS_BYTES)):
+        if isinstance(entry.get(key), str):
+            entry[key] = clip_middle(entry[key], limit)
 
 
 def _skip_reason(report: pytest.TestReport) -> str:
@@ -426,11 +464,13 @@ def _graph_guard(request: pytest.FixtureRequest) -> Iterator[None]:
 class StudentNode:
     """The student's running program, seen from the graph."""
 
-    def __init__(self, process: Any, name: str, probe: Any) -> None:
+    def __init__(self, process: Any, name: str, probe: Any,
+                 on_stop: Callable[[StudentNode], None] | None = None) -> None:
         self.process = process
         self.name = name
         self.probe = probe
         self.startup_seconds: float | None = None
+        self.on_stop = on_stop
 
     @property
     def returncode(self) -> int | None:
@@ -442,8 +482,13 @@ class StudentNode:
     def output(self) -> str:
         return self.process.output_text()
 
-    def output_tail(self, lines: int = 15) -> str:
-        return self.process.output_tail(lines)
+    def output_tail(self, lines: int = TAIL_LINES, max_bytes: int = TAIL_BYTES) -> str:
+        """The end of the program's output, short enough for a test message (a few lines,
+        a few KB), saying so when the program wrote more than the sandbox kept."""
+        tail = message_tail(self.output(), lines, max_bytes)
+        output = self.process.output
+        note = size_note(output.total, output.budget) if output is not None else ""
+        return "\n".join(part for part in (tail, note) if part)
 
     def wait_exit(self, wall_timeout: float) -> int | None:
         """Wait (wall time: exiting is the process's business) for it to end; its status."""
@@ -458,6 +503,9 @@ class StudentNode:
         self.probe.world.unwatch_pid(self.process.pid)
         if self.process.uid is not None:  # strict: our own folder in /tmp, not the run's
             shutil.rmtree(self.process.workdir, ignore_errors=True)
+        if self.on_stop is not None:  # once: a failed start stops it before the fixture does
+            on_stop, self.on_stop = self.on_stop, None
+            on_stop(self)
         return status
 
 
@@ -504,7 +552,7 @@ def launch(request: pytest.FixtureRequest, exercise: Any, script: Path, probe: A
             process.cgroup.bounds(separate_uid=process.uid is not None))
     process.start()
     world.watch_pid(process.pid)
-    node = StudentNode(process, exercise.node, probe)
+    node = StudentNode(process, exercise.node, probe, _log_keeper(request))
     if wait_for_node:
         earlier = request.config.stash.get(startup_key, None)
         if earlier is not None:  # it already failed to appear once: do not wait again
@@ -520,15 +568,6 @@ def launch(request: pytest.FixtureRequest, exercise: Any, script: Path, probe: A
     return node
 
 
-def _tail_with_size(node: StudentNode) -> str:
-    """The end of the program's output, saying so when a flood was cut short."""
-    tail = node.output_tail()
-    output = node.process.output
-    if output is not None and output.total > output.budget:
-        tail += "\n" + _("(Your program wrote {size} bytes of output; only the first and "
-                         "last {kept} bytes were kept.)").format(size=output.total,
-                                                                 kept=output.budget // 2)
-    return tail
 
 
 def _ros_value(value: Any) -> str:
@@ -574,17 +613,17 @@ def _wait_for_node(exercise: Any, node: StudentNode, world: Any, stale: set[byte
     if found:
         node.startup_seconds = time.monotonic() - node.process.started_at
         return
-    tail = _tail_with_size(node)
     if not node.running():
         code = node.returncode
-        node.stop()
+        node.stop()  # drains the pipe, so the tail ends with its last words
         raise StudentFailure(
             _("Your program {how} before its node '{node}' appeared on the ROS graph.\n"
               "Last lines of its output:\n{tail}").format(
                 how=_describe_exit(code if code is not None else 0), node=exercise.node,
-                tail=tail or _("(no output)")),
+                tail=node.output_tail() or _("(no output)")),
             _("Run it yourself with `python {file} --ros-args -p use_sim_time:=true` and "
               "read the traceback.").format(file=exercise.file))
+    tail = node.output_tail()  # before SIGINT: what it was doing, not how it stopped
     others = sorted(node.probe.node_names() - {"autograder_probe", "sim_world"})
     node.stop()
     raise NodeNeverAppeared(
@@ -619,7 +658,6 @@ def student(request: pytest.FixtureRequest, exercise: Any, submission_file: Path
         yield node
     finally:
         node.stop()
-        _keep_log(request, node)
 
 
 @pytest.fixture
@@ -638,10 +676,13 @@ def start_node(request: pytest.FixtureRequest, exercise: Any, submission_file: P
     finally:
         for node in started:
             node.stop()
-            _keep_log(request, node)
 
 
-def _keep_log(request: pytest.FixtureRequest, node: StudentNode) -> None:
+def _log_keeper(request: pytest.FixtureRequest) -> Callable[[StudentNode], None] | None:
+    """What keeps a program's output when it stops, however it stops (a failed start
+    too), under the test or module that started it."""
     reporter = request.config.stash.get(reporter_key, None)
-    if reporter is not None:
-        reporter.data["logs"][request.node.nodeid] = node.output_tail(40)
+    if reporter is None:
+        return None
+    nodeid = request.node.nodeid
+    return lambda node: reporter.keep_log(nodeid, node.output())

@@ -85,6 +85,9 @@ class RunResult:
     log_tail: str = ""
     execution_time: float = 0.0
     data: dict[str, Any] = dataclasses.field(default_factory=dict)
+    # Every student program's output as the sandbox kept it (up to its output budget
+    # each): for the HTML report and the log file beside the results, never in the JSON.
+    log: str = ""
 
     @property
     def score(self) -> Fraction:

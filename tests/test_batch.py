@@ -101,6 +101,7 @@ def test_batch_with_two_jobs_matches_one_by_one(tmp_path, submissions, one_by_on
     assert "shout:test_upper_case" in next(iter(graded.values()))
     assert (out / "student00" / "report.html").exists()
     assert (out / "student00" / "gradescope.json").exists()
+    assert "RuntimeError: boom" in (out / "student04" / "output.log").read_text()  # crash
 
 
 def _processes() -> dict[int, tuple[int, str]]:

@@ -17,11 +17,14 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
+from markupsafe import escape
 
+from autograder.cli import write_outputs
 from autograder.exercise import find_exercise
 from autograder.grading import grade
 from autograder.isolation import detect
 from autograder.leftovers import leftovers
+from autograder.render.terminal import to_terminal
 from autograder.results import RunResult
 
 pytestmark = pytest.mark.slow
@@ -119,7 +122,7 @@ def test_ends_with_a_score_a_message_and_nothing_left(graded, course, name):
 
 @pytest.mark.parametrize("name", ["import_loop", "sleep_forever", "fork_bomb", "memory_bomb",
                                   "output_flood", "huge_file", "os_exit", "segfault",
-                                  "sys_exit_before_spin"])
+                                  "sys_exit_before_spin", "flood_before_node"])
 def test_programs_that_never_run_a_node_score_zero(graded, name):
     assert graded[name][0].score == 0
 
@@ -127,6 +130,8 @@ def test_programs_that_never_run_a_node_score_zero(graded, name):
 @pytest.mark.parametrize("name,expected", [
     ("segfault", "SIGSEGV"), ("memory_bomb", "MemoryError"), ("huge_file", "File too large"),
     ("output_flood", "bytes of output; only the first and last"),
+    ("flood_before_node", "bytes of output; only the first and last"),
+    ("flood_before_node", "RuntimeError: gave up after the flood"),
     ("os_exit", "exited with status 0"),
     ("sys_exit_before_spin", "exited with status 0"),
     ("import_loop", "No node named 'shouter'"),
@@ -140,6 +145,36 @@ def test_tampering_is_caught_not_rewarded(graded, name):
     result = graded[name][0]
     assert result.score < result.max_score
     assert "Tampering with the simulated world" in messages(result)
+
+
+MB = 1 << 20
+
+
+@pytest.mark.parametrize("name", ["flood_before_node", "output_flood"])
+def test_output_floods_stay_out_of_the_messages(graded, name):
+    """Each message carries a few lines of the output, whatever the program wrote."""
+    for test in graded[name][0].tests:
+        assert len(test.message.encode()) <= 4096, test.name
+        assert len(test.message.splitlines()) <= 20, test.name
+
+
+def test_a_flood_gives_small_results_and_its_whole_log_once(graded, course, tmp_path):
+    """64 MB before the node: results files well under 1 MB; the kept output, head and
+    tail, once in the HTML report and in the log file beside the results."""
+    result = graded["flood_before_node"][0]
+    files = {name: tmp_path / f"out.{name}" for name in ("results", "html", "gradescope",
+                                                          "junit")}
+    write_outputs(result, dict(files), course.folder)
+    for name in ("results", "gradescope", "junit"):
+        assert files[name].stat().st_size < MB, name
+    assert len(to_terminal(result).encode()) < MB
+    log = (tmp_path / "out.log").read_text(encoding="utf-8")
+    assert log == result.log
+    assert "FLOOD BEGINS" in log and "RuntimeError: gave up after the flood" in log
+    assert "bytes of output dropped" in log  # the sandbox's budget, not ours, cut it
+    assert len(log) > 256 * 1024 > 16 * files["results"].stat().st_size  # not in the JSON
+    html = files["html"].read_text(encoding="utf-8")
+    assert html.count(str(escape(log))) == 1
 
 
 def test_a_flood_does_not_stop_grading(graded):

@@ -2,7 +2,9 @@
 
 Built from the results model alone: the robot's path over the world (collisions marked),
 message-interval plots for rate tests, each test's feedback as the student may see it,
-and the tail of the node's log.  Urdu pages are right to left, like the quiz pages.
+and, once, the whole output of the student's programs as the sandbox kept it (the tail of
+the node's log when only that is known).  Urdu pages are right to left, like the quiz
+pages.
 """
 
 from __future__ import annotations
