@@ -27,6 +27,11 @@ def test_github_matrix_shards_and_merges():
     assert flow["jobs"]["shard"]["strategy"]["matrix"]["shard"] == [1, 2, 3, 4, 5]
     shard_runs = " ".join(s.get("run", "") for s in flow["jobs"]["shard"]["steps"])
     assert "--shard ${{ matrix.shard }}/5" in shard_runs
+    course = next(s for s in flow["jobs"]["shard"]["steps"]
+                  if s.get("with", {}).get("repository") == "course/hidden")
+    assert course["with"]["path"] == "course"
+    grading = next(s for s in flow["jobs"]["shard"]["steps"] if "grade-batch" in s.get("run", ""))
+    assert grading["env"]["AUTOGRADER_COURSE"] == "${{ github.workspace }}/course"
     merge_runs = " ".join(s.get("run", "") for s in flow["jobs"]["merge"]["steps"])
     assert "autograder gradebook merge gradebook.csv" in merge_runs
     assert flow["jobs"]["merge"]["needs"] == "shard"
