@@ -76,9 +76,12 @@ def detect() -> Isolation:
         return Isolation(False, N_("a test program could not run in strict isolation"),
                          "no answer within 120 s")
     if probe.returncode != 0:
-        detail = (probe.stdout + probe.stderr).strip().splitlines()
+        detail = " / ".join((probe.stdout + probe.stderr).strip().splitlines()[-3:])
+        if probe.stderr.startswith("unshare:"):  # the namespaces themselves were refused
+            return Isolation(False, N_("namespaces are not allowed here (an unprivileged "
+                                       "container?)"), detail)
         return Isolation(False, N_("a test program could not run in strict isolation"),
-                         " / ".join(detail[-3:]))
+                         detail)
     return Isolation(True)
 
 

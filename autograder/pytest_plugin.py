@@ -549,7 +549,9 @@ def launch(request: pytest.FixtureRequest, exercise: Any, script: Path, probe: A
     if reporter is not None:
         process.on_spawn = lambda: reporter.note_process(
             process.pid, [str(p) for p in process.cgroup.paths],
-            process.cgroup.bounds(separate_uid=process.uid is not None))
+            # RLIMIT_NPROC binds every user but root: a uid of the student's own, or an
+            # ordinary grading user (where it counts that user's other processes too).
+            process.cgroup.bounds(separate_uid=process.uid is not None or os.geteuid() != 0))
     process.start()
     world.watch_pid(process.pid)
     node = StudentNode(process, exercise.node, probe, _log_keeper(request))
@@ -614,15 +616,7 @@ def _wait_for_node(exercise: Any, node: StudentNode, world: Any, stale: set[byte
         node.startup_seconds = time.monotonic() - node.process.started_at
         return
     if not node.running():
-        code = node.returncode
-        node.stop()  # drains the pipe, so the tail ends with its last words
-        raise StudentFailure(
-            _("Your program {how} before its node '{node}' appeared on the ROS graph.\n"
-              "Last lines of its output:\n{tail}").format(
-                how=_describe_exit(code if code is not None else 0), node=exercise.node,
-                tail=node.output_tail() or _("(no output)")),
-            _("Run it yourself with `python {file} --ros-args -p use_sim_time:=true` and "
-              "read the traceback.").format(file=exercise.file))
+        raise _exited_at_start(node, exercise)
     tail = node.output_tail()  # before SIGINT: what it was doing, not how it stopped
     others = sorted(node.probe.node_names() - {"autograder_probe", "sim_world"})
     node.stop()
@@ -633,6 +627,26 @@ def _wait_for_node(exercise: Any, node: StudentNode, world: Any, stale: set[byte
             others=", ".join(others) or _("none"), tail=tail or _("(no output)")),
         _("Create the node with `super().__init__('{node}')` and spin it.").format(
             node=exercise.node))
+
+
+def _exited_at_start(node: StudentNode, exercise: Any) -> StudentFailure:
+    """A program that ended during its start-up, said the same way whether or not the graph
+    showed its node first: that depends on how fast discovery was, not on the program (a
+    node created and then crashing in its constructor can go either way). The hint follows
+    the exit status, which does not race."""
+    code = node.returncode
+    node.stop()  # drains the pipe, so the tail ends with its last words
+    message = _("Your program {how} during start-up, before its node '{node}' was up and "
+                "spinning.\nLast lines of its output:\n{tail}").format(
+        how=_describe_exit(code if code is not None else 0), node=exercise.node,
+        tail=node.output_tail() or _("(no output)"))
+    if code == 0:
+        return StudentFailure(message, _("Call `rclpy.spin(node)` (or an executor's "
+                                         "`spin()`) after creating the node, and keep "
+                                         "spinning until the program is stopped."))
+    return StudentFailure(message, _(
+        "Run it yourself with `python {file} --ros-args -p use_sim_time:=true` and read the "
+        "traceback.").format(file=exercise.file))
 
 
 @pytest.fixture(scope="module")
@@ -646,14 +660,7 @@ def student(request: pytest.FixtureRequest, exercise: Any, submission_file: Path
     # A program that creates its node and quits at once must fail the same way every time,
     # whether or not we saw the node in between: watch it for a moment of sim time.
     if probe.wait_for(lambda: not node.running(), STARTUP_SETTLE):
-        code = node.returncode
-        node.stop()
-        raise StudentFailure(
-            _("Your program {how} right after its node appeared; a node must keep running "
-              "until it is stopped.\nLast lines of its output:\n{tail}").format(
-                how=_describe_exit(code if code is not None else 0),
-                tail=node.output_tail() or _("(no output)")),
-            _("Call `rclpy.spin(node)` (or an executor's `spin()`) after creating the node."))
+        raise _exited_at_start(node, exercise)
     try:
         yield node
     finally:

@@ -120,3 +120,16 @@ def test_strict_isolation_with_the_venv_and_the_course_under_tmp(tmp_setup, tmp_
     _data, log = _grade_from(venv, course, REPO / "tests/submissions/hostile/reads_secrets",
                              tmp_path / "secrets.json")
     assert "SECRETS FOUND: 0" in log
+
+
+@pytest.mark.skipif(os.geteuid() != 0 or not shutil.which("setpriv")
+                    or not shutil.which("unshare"), reason="needs root, setpriv and unshare")
+def test_refused_namespaces_are_named_as_the_reason():
+    """In an unprivileged container (no CAP_SYS_ADMIN) the reason says namespaces were
+    refused, not that the venv is unreadable."""
+    code = "from autograder.isolation import detect; i = detect(); print(i.mode, i.reason)"
+    run = subprocess.run(["setpriv", "--bounding-set=-sys_admin", "--inh-caps=-sys_admin",
+                          sys.executable, "-c", code], capture_output=True, text=True,
+                         env=dict(os.environ, PYTHONPATH=str(REPO)), timeout=120)
+    assert run.stdout.strip() == ("basic namespaces are not allowed here (an unprivileged "
+                                  "container?)"), run.stderr

@@ -11,8 +11,8 @@ install takes about 10 s here (pip's cache and the local indexes), so each run m
 real one rather than borrowing the project's venv. Steps that only bring files (volumes,
 git-sync, ``actions/checkout``, artifacts) are done by the test, from their YAML.
 
-Everything lives in a folder of mode 0755 under /tmp, not pytest's 0700 one: where the
-platform runs a student's program as a uid of its own, that uid must reach the venv.
+Everything lives in a folder of mode 0755 under /tmp, not pytest's 0700 one, as a
+course's folders would on a pod's volume.
 """
 
 from __future__ import annotations
