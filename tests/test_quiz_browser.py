@@ -15,7 +15,6 @@ from autograder.quiz.render import render_page
 from autograder.quiz.server import QuizServer
 
 REPO = Path(__file__).resolve().parent.parent
-SCREENSHOT = Path("/tmp/quiz-rclpy-part2-ur.png")
 
 
 @pytest.fixture
@@ -87,7 +86,7 @@ def test_urdu_page_renders_rtl_in_nastaliq_unclipped(tmp_path: Path) -> None:
         page.goto(html.as_uri())
         page.evaluate("document.fonts.ready")
         layout = page.evaluate(_LAYOUT_JS)
-        png = page.screenshot(full_page=True, path=str(SCREENSHOT))
+        png = page.screenshot(full_page=True, path=str(tmp_path / "quiz-rclpy-part2-ur.png"))
         title = page.locator("h1").bounding_box()
         stats = ink(page, png)
         title_ink = ink(page, png, (0, int(title["y"]), 900, int(title["height"])))

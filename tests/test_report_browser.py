@@ -1,5 +1,6 @@
 """The Urdu HTML report in headless Chromium: right to left, Nastaliq unclipped, code LTR,
-pictures drawn. The screenshot is kept at /tmp/report-ur.png for a person to look at."""
+pictures drawn. The screenshot is kept in the test's tmp_path (report-ur.png) for a person
+to look at: a fixed path in /tmp would belong to whichever user ran the tests first."""
 
 from __future__ import annotations
 
@@ -12,8 +13,6 @@ from browser import chromium_page, ink
 from autograder.render.html import to_html
 from autograder.results import RunResult, TestResult
 from sim.recorder import Recording, Sample
-
-SCREENSHOT = Path("/tmp/report-ur.png")
 
 
 def urdu_result() -> RunResult:
@@ -65,7 +64,7 @@ def test_urdu_report_renders_rtl_in_nastaliq_unclipped(tmp_path: Path) -> None:
         page.goto(page_file.as_uri())
         page.evaluate("document.fonts.ready")
         layout = page.evaluate(_LAYOUT_JS)
-        png = page.screenshot(full_page=True, path=str(SCREENSHOT))
+        png = page.screenshot(full_page=True, path=str(tmp_path / "report-ur.png"))
         title = page.locator("h1").bounding_box()
         stats = ink(page, png)
         title_ink = ink(page, png, (0, int(title["y"]), 900, int(title["height"])))
