@@ -14,9 +14,9 @@ from pathlib import Path
 import click
 
 from autograder import __version__
-from autograder.declarative import ContentError
+from autograder.core.declarative import ContentError
 from autograder.i18n import LANGUAGES, _, get_language, ngettext, set_language
-from autograder.i18n_cli import i18n_cli
+from autograder.i18n.cli import i18n_cli
 from autograder.quiz.cli import quiz_cli
 from sim.cli import sim_cli
 
@@ -43,8 +43,8 @@ def main(lang: str | None) -> None:
         set_language(lang)
 
 
-def _exercise(name: str):  # noqa: ANN202 - returns autograder.exercise.Exercise
-    from autograder.exercise import find_exercise
+def _exercise(name: str):  # noqa: ANN202 - returns autograder.core.exercise.Exercise
+    from autograder.core.exercise import find_exercise
 
     try:
         return find_exercise(name)
@@ -68,7 +68,7 @@ def _lang_option(func):  # noqa: ANN001, ANN202
 @click.option("--json", "as_json", is_flag=True, help="Print JSON for tools.")
 def list_command(as_json: bool) -> None:
     """List the exercises and quizzes."""
-    from autograder.exercise import list_exercises
+    from autograder.core.exercise import list_exercises
 
     try:
         exercises = list_exercises()
@@ -125,10 +125,10 @@ def start(exercise: str, directory: Path | None) -> None:
 
 def _run(exercise: str, submission: Path, hidden: bool, outputs: dict[str, Path | None],
          rtf: float | None, domain: int | None) -> None:
-    from autograder.grading import grade
+    from autograder.core.results import TestResult, exact
+    from autograder.core.submission import SubmissionNotFound, locate
+    from autograder.grading.run import grade
     from autograder.render.terminal import test_line, to_terminal
-    from autograder.results import TestResult, exact
-    from autograder.submission import SubmissionNotFound, locate
 
     found = _exercise(exercise)
     try:
@@ -158,7 +158,7 @@ def write_outputs(result, outputs: dict[str, Path | None], folder: Path) -> None
     """Write each requested format of ``result`` (``--results``, ``--html``, ...); with
     ``--results FILE``, the programs' whole output goes to FILE with suffix ``.log``
     (``log`` names another file for it)."""
-    from autograder.output import log_beside
+    from autograder.core.output import log_beside
     from autograder.render.gradescope import to_gradescope
     from autograder.render.html import to_html
     from autograder.render.jsonfile import to_json
@@ -225,7 +225,7 @@ def grade_command(exercise: str, submission: Path, rtf: float | None, domain: in
 def release(out: Path) -> None:
     """Build what students get in OUT: starter code, READMEs, public tests and the tools to
     run them, quizzes as pages; no hidden tests, no solutions, no quiz keys."""
-    from autograder.release import build_release
+    from autograder.commands.release import build_release
 
     if out.exists():
         raise UsageProblem(_("{path} already exists").format(path=out))
@@ -246,7 +246,7 @@ def bundle() -> None:
 @click.argument("zip_path", metavar="OUT.zip", type=click.Path(path_type=Path, dir_okay=False))
 def bundle_gradescope(exercise: str, zip_path: Path) -> None:
     """A Gradescope autograder zip (setup.sh, run_autograder) for EXERCISE."""
-    from autograder.release import build_gradescope_bundle
+    from autograder.commands.release import build_gradescope_bundle
 
     build_gradescope_bundle(_exercise(exercise), zip_path)
     click.echo(_("Gradescope autograder written to {path}").format(path=zip_path))
@@ -268,7 +268,7 @@ def grade_batch(item: str, submissions: Path, jobs: int, csv_path: Path, out: Pa
                 shard: str | None) -> None:
     """Grade every submission in SUBMISSIONS (one sub-folder or file per student), or score
     every answers file for a quiz. Resumable: graded students are skipped."""
-    from autograder.batch import parse_shard, run_batch, students
+    from autograder.commands.batch import parse_shard, run_batch, students
 
     try:
         share = parse_shard(shard) if shard else None
@@ -291,7 +291,7 @@ def grade_batch(item: str, submissions: Path, jobs: int, csv_path: Path, out: Pa
 
 def _batch_item(item: str):  # noqa: ANN202
     """How to grade one student's entry for an exercise or a quiz."""
-    from autograder.grading import grade
+    from autograder.grading.run import grade
     from autograder.quiz.catalog import find_quiz
     from autograder.quiz.scoring import AnswersError, read_answers, score
 
@@ -331,7 +331,7 @@ def gradebook_group() -> None:
                 type=click.Path(path_type=Path, dir_okay=False, exists=True))
 def gradebook_merge(out: Path, inputs: tuple[Path, ...]) -> None:
     """Merge gradebooks (e.g. from shards) into OUT; a later file wins a duplicate row."""
-    from autograder import gradebook
+    from autograder.commands import gradebook
 
     try:
         rows = gradebook.merge(*(gradebook.read(p) for p in inputs))
@@ -357,7 +357,7 @@ def workflow(kind: str, exercise: str, submission: str, shards: int, platform_re
              hidden_repo: str, claim: str) -> None:
     """Print a CI workflow: a student repository's grade-on-push (github-student), or a
     course's sharded batch grading (github-shards, k8s-shards)."""
-    from autograder.workflows import render_workflow
+    from autograder.commands.workflows import render_workflow
 
     click.echo(render_workflow(kind, exercise=exercise, submission=submission, shards=shards,
                                platform_repo=platform_repo, hidden_repo=hidden_repo,
@@ -373,7 +373,7 @@ def workflow(kind: str, exercise: str, submission: str, shards: int, platform_re
 def validate(run_gradings: bool, jobs: int, course: Path | None) -> None:
     """Check a whole course: exercise files, starters and solutions, worlds, quizzes and
     catalogs; the reference solutions score 100% and the starters below the pass mark."""
-    from autograder.validate import validate as check_course
+    from autograder.commands.validate import validate as check_course
 
     problems = check_course(course, run_gradings=run_gradings, jobs=jobs,
                             progress=lambda e: click.echo(_("grading {exercise}...").format(

@@ -12,8 +12,8 @@ import collections
 import statistics
 import time
 
-from autograder.exercise import find_exercise, list_exercises
-from autograder.grading import grade
+from autograder.core.exercise import find_exercise, list_exercises
+from autograder.grading.run import grade
 
 
 def main() -> None:

@@ -35,10 +35,10 @@ def main() -> None:
     parser.add_argument("names", nargs="*")
     args = parser.parse_args()
     os.environ["AUTOGRADER_COURSE"] = str(COURSE)
-    from autograder.exercise import find_exercise
-    from autograder.grading import grade
-    from autograder.isolation import detect
-    from autograder.leftovers import leftovers
+    from autograder.core.exercise import find_exercise
+    from autograder.grading.run import grade
+    from autograder.sandbox.isolation import detect
+    from autograder.sandbox.leftovers import leftovers
 
     exercise = find_exercise("shout")
     names = args.names or sorted(p.name for p in CORPUS.iterdir())

@@ -13,8 +13,8 @@ import subprocess
 import sys
 import time
 
-from autograder.exercise import find_exercise, list_exercises
-from autograder.grading import grade
+from autograder.core.exercise import find_exercise, list_exercises
+from autograder.grading.run import grade
 
 
 def busy_loops(count: int) -> list[subprocess.Popen[bytes]]:

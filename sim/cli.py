@@ -12,7 +12,7 @@ from pathlib import Path
 
 import click
 
-from autograder.declarative import ContentError
+from autograder.core.declarative import ContentError
 from autograder.i18n import _
 from sim.worldfile import load_world, world_names, world_path
 

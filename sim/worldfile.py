@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Literal
 
-from autograder.declarative import ContentError, Document, build, load_document
+from autograder.core.declarative import ContentError, Document, build, load_document
 from autograder.i18n import _
 
 WORLDS_DIR = Path(__file__).resolve().parent / "worlds"

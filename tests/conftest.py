@@ -8,7 +8,7 @@ from typing import Any
 
 import pytest
 
-from autograder.domains import reserve_domain
+from autograder.sandbox.domains import reserve_domain
 
 
 @pytest.fixture(scope="module")

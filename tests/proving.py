@@ -14,9 +14,9 @@ import os
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-from autograder.exercise import find_exercise
-from autograder.grading import grade
-from autograder.results import RunResult
+from autograder.core.exercise import find_exercise
+from autograder.core.results import RunResult
+from autograder.grading.run import grade
 
 SUBMISSIONS = Path(__file__).parent / "submissions"
 # Gradings at a time: two, as `grade-batch --jobs 2` on this 2-core machine.

@@ -10,9 +10,9 @@ import pytest
 from click.testing import CliRunner
 
 from autograder.cli import main
-from autograder.exercise import load_exercise
-from autograder.grading import GRADER_FAULT, grade
-from autograder.validate import validate
+from autograder.commands.validate import validate
+from autograder.core.exercise import load_exercise
+from autograder.grading.run import GRADER_FAULT, grade
 
 MINI = Path(__file__).parent / "fixtures" / "mini_course"
 

@@ -15,9 +15,9 @@ from pathlib import Path
 
 import pytest
 
-from autograder.batch import in_shard
-from autograder.exercise import find_exercise
-from autograder.grading import grade
+from autograder.commands.batch import in_shard
+from autograder.core.exercise import find_exercise
+from autograder.grading.run import grade
 
 pytestmark = pytest.mark.slow
 

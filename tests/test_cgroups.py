@@ -1,4 +1,4 @@
-"""Cgroups v1 and v2 (autograder.cgroups): v2 on a fake cgroupfs tree, since the machines
+"""Cgroups v1 and v2 (autograder.sandbox.cgroups): v2 on a fake cgroupfs tree, since the machines
 that run this suite may be v1; v1 on a fake tree and, as root, on the machine's own."""
 
 from __future__ import annotations
@@ -15,9 +15,9 @@ from pathlib import Path
 
 import pytest
 
-from autograder import cgroups
-from autograder.cgroups import Cgroup, cgroup_root, describe_bounds, hierarchy
-from autograder.exercise import Limits
+from autograder.core.exercise import Limits
+from autograder.sandbox import cgroups
+from autograder.sandbox.cgroups import Cgroup, cgroup_root, describe_bounds, hierarchy
 
 LIMITS = Limits(processes=32, memory_mb=100)
 MEMORY_BYTES = str(100 * 1024 * 1024)

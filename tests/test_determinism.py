@@ -11,8 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from autograder.exercise import find_exercise
-from autograder.grading import grade
+from autograder.core.exercise import find_exercise
+from autograder.grading.run import grade
 
 pytestmark = pytest.mark.slow
 

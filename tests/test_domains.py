@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from autograder.domains import (
+from autograder.sandbox.domains import (
     DOMAIN_GAIN,
     FIRST_DOMAIN,
     PORT_BASE,
@@ -31,7 +31,7 @@ as_root = pytest.mark.skipif(os.geteuid() != 0, reason="needs root to run as ano
 # Reserve a domain as another user and print it (or the error, with no traceback).
 OTHER_USER = """
 import sys
-from autograder.domains import NoDomain, hold_domain
+from autograder.sandbox.domains import NoDomain, hold_domain
 try:
     with hold_domain() as lock:
         print("domain", lock.domain)

@@ -20,7 +20,7 @@ from proving import (  # noqa: F401 - the standard checks, collected here
     test_starter_is_below_the_pass_mark,
 )
 
-from autograder.exercise import find_exercise
+from autograder.core.exercise import find_exercise
 
 pytestmark = pytest.mark.slow
 

@@ -20,12 +20,12 @@ import pytest
 from markupsafe import escape
 
 from autograder.cli import write_outputs
-from autograder.exercise import find_exercise
-from autograder.grading import grade
-from autograder.isolation import detect
-from autograder.leftovers import leftovers
+from autograder.core.exercise import find_exercise
+from autograder.core.results import RunResult
+from autograder.grading.run import grade
 from autograder.render.terminal import to_terminal
-from autograder.results import RunResult
+from autograder.sandbox.isolation import detect
+from autograder.sandbox.leftovers import leftovers
 
 pytestmark = pytest.mark.slow
 

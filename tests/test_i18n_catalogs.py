@@ -11,7 +11,7 @@ from babel.messages.pofile import read_po
 from click.testing import CliRunner
 
 from autograder.i18n import translations
-from autograder.i18n_cli import i18n_cli
+from autograder.i18n.cli import i18n_cli
 from autograder.quiz.extract import extract_exercise, extract_quiz
 
 REPO = Path(__file__).resolve().parent.parent
@@ -38,7 +38,7 @@ def test_quiz_extractor_gives_contexts_and_real_lines() -> None:
 
 def test_identical_strings_in_different_questions_stay_separate(tmp_path: Path) -> None:
     out = tmp_path / "locales"
-    from autograder.i18n_tools import extract
+    from autograder.i18n.tools import extract
 
     extract(REPO, out)
     with (out / "content.pot").open("rb") as fh:

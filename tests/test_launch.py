@@ -16,10 +16,10 @@ from pathlib import Path
 
 import pytest
 
-from autograder.exercise import Limits
-from autograder.grading import GRADER_FAULT
-from autograder.isolation import detect
-from autograder.sandbox import LaunchFailed, student_process
+from autograder.core.exercise import Limits
+from autograder.grading.run import GRADER_FAULT
+from autograder.sandbox.isolation import detect
+from autograder.sandbox.process import LaunchFailed, student_process
 
 REPO = Path(__file__).resolve().parent.parent
 COURSE = REPO / "tests" / "fixtures" / "mini_course"
@@ -127,7 +127,7 @@ def test_strict_isolation_with_the_venv_and_the_course_under_tmp(tmp_setup, tmp_
 def test_refused_namespaces_are_named_as_the_reason():
     """In an unprivileged container (no CAP_SYS_ADMIN) the reason says namespaces were
     refused, not that the venv is unreadable."""
-    code = "from autograder.isolation import detect; i = detect(); print(i.mode, i.reason)"
+    code = "from autograder.sandbox.isolation import detect; i = detect(); print(i.mode, i.reason)"
     run = subprocess.run(["setpriv", "--bounding-set=-sys_admin", "--inh-caps=-sys_admin",
                           sys.executable, "-c", code], capture_output=True, text=True,
                          env=dict(os.environ, PYTHONPATH=str(REPO)), timeout=120)

@@ -10,9 +10,7 @@ from pathlib import Path
 import pytest
 
 from autograder.cli import _batch_item, write_outputs
-from autograder.grading import _with_output_log
-from autograder.i18n import set_language
-from autograder.output import (
+from autograder.core.output import (
     CUT,
     LINE_CHARS,
     TAIL_BYTES,
@@ -24,11 +22,13 @@ from autograder.output import (
     message_tail,
     size_note,
 )
-from autograder.pytest_plugin import GradingReporter, StudentNode, _bound
+from autograder.core.results import RunResult, TestResult
+from autograder.core.signing import verify
+from autograder.grading.run import _with_output_log
+from autograder.i18n import set_language
+from autograder.plugin import GradingReporter, StudentNode, _bound
 from autograder.render.html import to_html
-from autograder.results import RunResult, TestResult
-from autograder.sandbox import _Output
-from autograder.signing import verify
+from autograder.sandbox.process import _Output
 
 KEY = b"k" * 32
 

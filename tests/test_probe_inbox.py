@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import threading
 
-from autograder.probe import Inbox
+from autograder.plugin.probe import Inbox
 
 
 def test_a_flood_is_counted_not_kept(monkeypatch):

@@ -12,8 +12,8 @@ from pathlib import Path
 
 import pytest
 
-from autograder.exercise import list_exercises
-from autograder.release import build_gradescope_bundle, build_release, student_files
+from autograder.commands.release import build_gradescope_bundle, build_release, student_files
+from autograder.core.exercise import list_exercises
 
 ROOT = Path(__file__).resolve().parent.parent
 

@@ -8,13 +8,13 @@ from fractions import Fraction
 
 import pytest
 
+from autograder.core.results import RunResult, TestResult
 from autograder.i18n import set_language
 from autograder.render.gradescope import to_gradescope, to_gradescope_dict
 from autograder.render.html import to_html
 from autograder.render.jsonfile import to_json
 from autograder.render.junit import to_junit
 from autograder.render.terminal import to_terminal
-from autograder.results import RunResult, TestResult
 
 SECRET = "internal detail of a hidden test"
 

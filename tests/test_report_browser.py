@@ -10,8 +10,8 @@ from pathlib import Path
 
 from browser import chromium_page, ink
 
+from autograder.core.results import RunResult, TestResult
 from autograder.render.html import to_html
-from autograder.results import RunResult, TestResult
 from sim.recorder import Recording, Sample
 
 

@@ -33,7 +33,7 @@ import pytest
 import yaml
 from test_batch import EXPECTED, KINDS, VARIANTS
 
-from autograder.workflows import render_workflow
+from autograder.commands.workflows import render_workflow
 
 pytestmark = pytest.mark.slow
 

@@ -4,7 +4,7 @@ import yaml
 from click.testing import CliRunner
 
 from autograder.cli import main
-from autograder.workflows import render_workflow
+from autograder.commands.workflows import render_workflow
 
 VALUES = {"exercise": "timer_sync", "submission": "src", "shards": 5,
           "platform_repo": "https://example.invalid/platform", "hidden_repo": "course/hidden",

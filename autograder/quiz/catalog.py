@@ -5,8 +5,8 @@ from __future__ import annotations
 import dataclasses
 from pathlib import Path
 
-from autograder.course import course_root
-from autograder.declarative import ContentError
+from autograder.core.course import course_root
+from autograder.core.declarative import ContentError
 from autograder.i18n import _, content_text
 from autograder.quiz.model import QuizFile, context, load_quiz
 

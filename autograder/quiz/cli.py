@@ -14,7 +14,8 @@ from typing import Any, TypeVar
 
 import click
 
-from autograder.declarative import ContentError
+from autograder.core.declarative import ContentError
+from autograder.core.results import RunResult
 from autograder.i18n import (
     LANGUAGES,
     _,
@@ -24,7 +25,7 @@ from autograder.i18n import (
     ngettext,
     set_language,
 )
-from autograder.i18n_tools import CatalogError, read_catalog
+from autograder.i18n.tools import CatalogError, read_catalog
 from autograder.quiz import CONTENT_DOMAIN
 from autograder.quiz.catalog import find_quiz, list_quizzes, load_all
 from autograder.quiz.errors import AnswersFileError, ContentFileError, LintFailed, ServeError
@@ -39,7 +40,6 @@ from autograder.quiz.scoring import (
     result_dict,
     score,
 )
-from autograder.results import RunResult
 
 F = TypeVar("F", bound=Callable[..., Any])
 

@@ -13,7 +13,7 @@ from collections.abc import Collection, Iterator, Mapping
 from pathlib import Path
 from typing import IO, Any
 
-from autograder.declarative import load_document
+from autograder.core.declarative import load_document
 from autograder.quiz.model import load_quiz, strings
 
 Extracted = tuple[int, str, tuple[str, str], list[str]]

@@ -9,9 +9,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from autograder.declarative import ContentError
+from autograder.core.declarative import ContentError
 from autograder.i18n import _, locales_dir
-from autograder.i18n_tools import CatalogError, Problem, check_message, read_catalog
+from autograder.i18n.tools import CatalogError, Problem, check_message, read_catalog
 from autograder.quiz import CONTENT_DOMAIN
 from autograder.quiz.catalog import quiz_paths
 from autograder.quiz.model import QuizFile, check_ids_unique, load_quiz, strings

@@ -1,7 +1,7 @@
 """A quiz file parsed into frozen dataclasses, with every key checked against its options.
 
 The answer key names option ids, never positions or text, so shuffling and translation
-cannot break it.  A malformed file is a :class:`~autograder.declarative.ContentError`
+cannot break it.  A malformed file is a :class:`~autograder.core.declarative.ContentError`
 naming the file, the line and the field.
 """
 
@@ -15,9 +15,9 @@ from fractions import Fraction
 from pathlib import Path
 from typing import Any, Literal
 
-from autograder.declarative import ContentError, Document, build, load_document
+from autograder.core.declarative import ContentError, Document, build, load_document
+from autograder.core.results import exact
 from autograder.i18n import _
-from autograder.results import exact
 
 QuestionType = Literal["single", "multiple", "true_false", "numeric", "ordering"]
 ID_PATTERN = re.compile(r"^[a-z0-9][a-z0-9_-]*$")

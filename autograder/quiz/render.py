@@ -14,6 +14,7 @@ from typing import Any
 import jinja2
 from markupsafe import Markup
 
+from autograder.core.results import RunResult
 from autograder.i18n import _, is_rtl, ngettext
 from autograder.quiz.localize import (
     CODE_SPAN,
@@ -31,7 +32,6 @@ from autograder.quiz.localize import (
 from autograder.quiz.model import Quiz
 from autograder.quiz.scoring import pass_summary
 from autograder.quiz.shuffle import option_order
-from autograder.results import RunResult
 
 FONT_STACK_UR = ('"Noto Nastaliq Urdu", "Jameel Noori Nastaleeq", "Urdu Typesetting", '
                  '"Noto Naskh Arabic", serif')

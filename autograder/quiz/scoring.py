@@ -10,10 +10,10 @@ from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
+from autograder.core.results import RunResult, TestResult, exact
 from autograder.i18n import _, ngettext
 from autograder.quiz.localize import Localizer, format_number, format_percent, using_language
 from autograder.quiz.model import Question, Quiz
-from autograder.results import RunResult, TestResult, exact
 
 ANSWERS_KEYS = {"quiz", "answers", "seed", "lang", "student"}
 

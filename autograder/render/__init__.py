@@ -1,1 +1,1 @@
-"""Pure renderers of a :class:`~autograder.results.RunResult`: one module per format."""
+"""Pure renderers of a :class:`~autograder.core.results.RunResult`: one module per format."""

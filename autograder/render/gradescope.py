@@ -5,8 +5,8 @@ from __future__ import annotations
 import json
 from typing import Any
 
+from autograder.core.results import RunResult, TestResult, number
 from autograder.i18n import _
-from autograder.results import RunResult, TestResult, number
 
 # Gradescope's visibility values; our "hidden" tests follow the exercise's setting.
 _VISIBILITY = {"visible": "visible", "hidden": "hidden", "after_published": "after_published"}

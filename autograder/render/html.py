@@ -14,11 +14,11 @@ from typing import Any
 
 from markupsafe import Markup
 
+from autograder.core.results import RunResult, number
 from autograder.i18n import is_rtl
 from autograder.quiz.localize import Text, format_percent, using_language
 from autograder.quiz.render import environment
 from autograder.render.charts import intervals_svg
-from autograder.results import RunResult, number
 
 
 def _trajectories(result: RunResult, exercise_folder: Path | None) -> list[dict[str, Any]]:

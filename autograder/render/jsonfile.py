@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 
-from autograder.results import RunResult
+from autograder.core.results import RunResult
 
 
 def to_json(result: RunResult) -> str:

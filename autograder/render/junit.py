@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 
-from autograder.results import RunResult, number
+from autograder.core.results import RunResult, number
 
 
 def to_junit(result: RunResult) -> str:

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from babel.numbers import format_percent
 
+from autograder.core.results import RunResult, TestResult, as_decimal, number
 from autograder.i18n import _
-from autograder.results import RunResult, TestResult, as_decimal, number
 
 _MARKS = {"passed": ("✔", "green"), "failed": ("✘", "red"), "error": ("!", "yellow"),
           "skipped": ("-", "yellow")}

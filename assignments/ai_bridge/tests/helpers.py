@@ -12,7 +12,7 @@ from typing import Any
 
 from std_msgs.msg import String
 
-from autograder.errors import StudentFailure
+from autograder.core.errors import StudentFailure
 from autograder.i18n import _
 
 REACHED = 0.3              # m from the goal: inside counts as reached

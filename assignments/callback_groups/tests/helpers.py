@@ -17,7 +17,7 @@ from typing import Any
 import pytest
 from std_srvs.srv import Trigger
 
-from autograder.errors import StudentFailure
+from autograder.core.errors import StudentFailure
 from autograder.i18n import _
 
 SERVICE = "check_path"

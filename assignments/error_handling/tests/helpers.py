@@ -10,7 +10,7 @@ from typing import Any
 from geometry_msgs.msg import Twist
 from sensor_msgs.msg import LaserScan
 
-from autograder.errors import StudentFailure
+from autograder.core.errors import StudentFailure
 from autograder.i18n import _
 
 # The simulated lidar: 360 beams counter-clockwise from straight ahead, 0.12 to 3.5 m.

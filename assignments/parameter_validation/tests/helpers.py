@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from geometry_msgs.msg import Twist
 
-from autograder.errors import StudentFailure
+from autograder.core.errors import StudentFailure
 from autograder.i18n import _
 
 # After an answer arrives, this much simulation time is watched for a second one.

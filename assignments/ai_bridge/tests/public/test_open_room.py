@@ -3,7 +3,7 @@
 import pytest
 from helpers import REACHED, STATUS_WITHIN, judge_efficiency, judge_reached
 
-from autograder.errors import StudentFailure
+from autograder.core.errors import StudentFailure
 from autograder.i18n import _
 from sim.worldfile import load_world
 

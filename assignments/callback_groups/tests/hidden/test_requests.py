@@ -17,7 +17,7 @@ from helpers import (
     wait_student_idle,
 )
 
-from autograder.errors import StudentFailure
+from autograder.core.errors import StudentFailure
 from autograder.i18n import _
 from sim.worldfile import Box, Fault
 

@@ -16,7 +16,7 @@ from helpers import (
     scan_after,
 )
 
-from autograder.errors import GraderError, StudentFailure
+from autograder.core.errors import GraderError, StudentFailure
 from autograder.i18n import _
 from sim.worldfile import Box, Fault
 

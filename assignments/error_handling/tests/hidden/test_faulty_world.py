@@ -15,7 +15,7 @@ from typing import Any
 import pytest
 from helpers import LATE, describe, is_zero, warnings_between, window
 
-from autograder.errors import StudentFailure
+from autograder.core.errors import StudentFailure
 from autograder.i18n import _
 from sim.worldfile import Fault
 

@@ -14,7 +14,7 @@ import pytest
 from geometry_msgs.msg import Twist
 from helpers import describe, is_zero
 
-from autograder.errors import StudentFailure
+from autograder.core.errors import StudentFailure
 from autograder.i18n import _
 
 pytestmark = pytest.mark.world("empty_room")

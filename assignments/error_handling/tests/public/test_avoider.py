@@ -28,7 +28,7 @@ from helpers import (
 )
 from sensor_msgs.msg import LaserScan
 
-from autograder.errors import StudentFailure
+from autograder.core.errors import StudentFailure
 from autograder.i18n import _
 from sim.worldfile import Fault
 

@@ -3,7 +3,7 @@
 import pytest
 from helpers import answer, close, ready, twist
 
-from autograder.errors import StudentFailure
+from autograder.core.errors import StudentFailure
 from autograder.i18n import _
 
 NODE = "velocity_governor"

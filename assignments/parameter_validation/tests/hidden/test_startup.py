@@ -2,7 +2,7 @@
 
 import pytest
 
-from autograder.errors import StudentFailure
+from autograder.core.errors import StudentFailure
 from autograder.i18n import _
 
 # Startup is a matter of the process, not of simulation time: wall seconds.

@@ -5,7 +5,7 @@ from geometry_msgs.msg import Twist
 from helpers import ready, twist
 from nav_msgs.msg import Odometry
 
-from autograder.errors import StudentFailure
+from autograder.core.errors import StudentFailure
 from autograder.i18n import _
 
 pytestmark = pytest.mark.world("empty_room")

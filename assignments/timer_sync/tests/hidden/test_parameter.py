@@ -3,7 +3,7 @@
 import pytest
 from geometry_msgs.msg import Twist
 
-from autograder.errors import StudentFailure
+from autograder.core.errors import StudentFailure
 from autograder.i18n import _
 
 SPEED = 0.35

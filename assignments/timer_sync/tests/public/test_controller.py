@@ -18,7 +18,7 @@ from helpers import (
     require_not_frozen,
 )
 
-from autograder.errors import StudentFailure
+from autograder.core.errors import StudentFailure
 from autograder.i18n import _
 
 CRUISE = 0.2

@@ -57,7 +57,7 @@ def student_uid(domain: int) -> int:
 @functools.cache
 def detect() -> Isolation:
     """Strict isolation if we are root, namespaces work, and a test program started the
-    way every student's program is (:func:`autograder.sandbox.student_process`, in the
+    way every student's program is (:func:`autograder.sandbox.process.student_process`, in the
     run's namespaces) runs Python and rclpy as a user of its own: if the check passes,
     launches work; if not, basic isolation is used and the reason is kept."""
     if os.environ.get("AUTOGRADER_ISOLATION") == "basic":
@@ -69,7 +69,7 @@ def detect() -> Isolation:
         return Isolation(False, N_("the unshare command (util-linux) is missing"))
     try:
         probe = subprocess.run(
-            [*run_prefix(Isolation(True)), sys.executable, "-m", "autograder.isolation"],
+            [*run_prefix(Isolation(True)), sys.executable, "-m", "autograder.sandbox.isolation"],
             capture_output=True, text=True, timeout=120,
             env=dict(os.environ, PYTHONPATH=_package_parent()))
     except subprocess.TimeoutExpired:
@@ -101,8 +101,8 @@ def probe_launch() -> str | None:
     it ran as its own user, else what went wrong. Runs inside the run's namespaces."""
     import tempfile
 
-    from autograder.exercise import Limits
-    from autograder.sandbox import LaunchFailed, student_process
+    from autograder.core.exercise import Limits
+    from autograder.sandbox.process import LaunchFailed, student_process
 
     bring_up_loopback()
     with tempfile.TemporaryDirectory(prefix="autograder-probe-") as tmp:
@@ -128,7 +128,7 @@ def probe_launch() -> str | None:
 
 
 def _package_parent() -> str:
-    return str(Path(__file__).resolve().parent.parent)
+    return str(Path(__file__).resolve().parents[2])
 
 
 def run_prefix(isolation: Isolation) -> list[str]:

@@ -26,7 +26,7 @@ def locales_dir() -> Path:
     env = os.environ.get("AUTOGRADER_LOCALES")
     if env:
         return Path(env)
-    from autograder.course import course_root
+    from autograder.core.course import course_root
 
     return course_root() / "locales"
 

@@ -14,8 +14,8 @@ import stat
 import zipfile
 from pathlib import Path
 
-from autograder.course import course_root
-from autograder.exercise import Exercise, list_exercises
+from autograder.core.course import course_root
+from autograder.core.exercise import Exercise, list_exercises
 
 # The platform itself: what `pip install .` needs and what runs the tests.
 PLATFORM = ("pyproject.toml", "README.md", "tasks.py", "Makefile", "babel.cfg", "autograder",

@@ -7,8 +7,8 @@ from fractions import Fraction
 from pathlib import Path
 from typing import Literal
 
-from autograder.course import course_root
-from autograder.declarative import ContentError, build, load_document
+from autograder.core.course import course_root
+from autograder.core.declarative import ContentError, build, load_document
 from autograder.i18n import _, content_text
 
 

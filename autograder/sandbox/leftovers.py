@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from autograder.results import RunResult
+from autograder.core.results import RunResult
 
 
 def leftovers(result: RunResult) -> list[int]:

@@ -26,7 +26,7 @@ import tempfile
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 
-from autograder.errors import GraderError
+from autograder.core.errors import GraderError
 
 # Domains 0-9 are left to people running nodes by hand; with Linux's default ephemeral
 # port range, ids up to 101 are safe for Fast DDS.

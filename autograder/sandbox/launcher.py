@@ -3,9 +3,9 @@
 Runs as a fresh single-threaded process (so no ``preexec_fn`` runs in the threaded
 grader) and ``exec``s the student's command once it is contained::
 
-    python -m autograder.sandbox_exec SPEC_JSON -- COMMAND...
+    python -m autograder.sandbox.launcher SPEC_JSON -- COMMAND...
 
-SPEC holds ``limits`` (see ``autograder.exercise.Limits``), ``cgroups`` (folders to
+SPEC holds ``limits`` (see ``autograder.core.exercise.Limits``), ``cgroups`` (folders to
 join) and ``status_fd``, and for strict isolation ``uid``, ``hide`` (paths to cover with
 an empty read-only filesystem), ``workdir`` and ``workdir_mb`` (a tmpfs of that size,
 owned by ``uid``, filled with the files staged there).  Strict steps need root; the
@@ -189,7 +189,7 @@ def interpreter_paths() -> list[str]:
     """What the student's Python needs to run here: the interpreter, its environment, and
     every folder on its module path (a venv's site-packages, a system ROS install's), but
     not this platform's own checkout, whose way onto the path is the launcher's."""
-    own = os.path.realpath(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    own = os.path.realpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
     here = os.path.realpath(os.getcwd())
     found = [sys.prefix, sys.base_prefix, sys.exec_prefix,
              os.path.dirname(os.path.realpath(sys.executable))]

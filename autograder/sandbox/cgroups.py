@@ -53,7 +53,7 @@ from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any, Literal
 
-from autograder.exercise import Limits
+from autograder.core.exercise import Limits
 
 Version = Literal["v1", "v2"]
 CONTROLLERS = ("pids", "memory")

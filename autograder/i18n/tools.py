@@ -24,7 +24,7 @@ from autograder.i18n import _
 
 PLATFORM_DOMAIN = "messages"
 CONTENT_DOMAIN = "content"
-PLATFORM_METHODS = frozenset({"python", "jinja2", "autograder.label_extract:extract_tests"})
+PLATFORM_METHODS = frozenset({"python", "jinja2", "autograder.i18n.label_extract:extract_tests"})
 KEYWORDS = {**DEFAULT_KEYWORDS, "N_": None}
 COMMENT_TAGS = ("TRANSLATORS:",)
 PROJECT = "rclpy-autograder"

@@ -11,9 +11,9 @@ from pathlib import Path
 
 import click
 
-from autograder.course import course_root
+from autograder.core.course import course_root
 from autograder.i18n import LANGUAGES, _, locales_dir, ngettext
-from autograder.i18n_tools import CatalogError, check_catalog, compile_catalogs, extract, update
+from autograder.i18n.tools import CatalogError, check_catalog, compile_catalogs, extract, update
 from autograder.quiz.errors import ContentFileError, LintFailed
 
 _TARGETS = tuple(lang for lang in LANGUAGES if lang != "en")

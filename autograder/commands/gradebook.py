@@ -13,9 +13,9 @@ import os
 from collections.abc import Iterable
 from pathlib import Path
 
-from autograder.declarative import ContentError
+from autograder.core.declarative import ContentError
+from autograder.core.results import RunResult, number
 from autograder.i18n import _
-from autograder.results import RunResult, number
 
 BASE_COLUMNS = ["student", "item", "score", "max_score", "passed"]
 

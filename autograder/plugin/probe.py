@@ -20,7 +20,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter, parameter_value_to_python
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 
-from autograder.errors import GraderError, StudentFailure
+from autograder.core.errors import GraderError, StudentFailure
 from autograder.i18n import _
 
 M = TypeVar("M")

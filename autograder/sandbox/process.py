@@ -1,6 +1,6 @@
 """Run a student's program as its own process, contained and bounded.
 
-Each program runs through :mod:`autograder.sandbox_exec` in its own session and process
+Each program runs through :mod:`autograder.sandbox.launcher` in its own session and process
 group, in a throwaway working directory, with a minimal environment and resource limits.
 Where the machine lets us create cgroups (v1 ``pids`` and ``memory``), the program also
 runs in a cgroup of its own: that bounds processes even for root and lets :meth:`stop`
@@ -25,9 +25,9 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from autograder.cgroups import Cgroup
-from autograder.errors import GraderError
-from autograder.exercise import Limits
+from autograder.core.errors import GraderError
+from autograder.core.exercise import Limits
+from autograder.sandbox.cgroups import Cgroup
 
 _PASS_THROUGH = (
     "PATH", "LD_LIBRARY_PATH", "PYTHONPATH", "AMENT_PREFIX_PATH", "ROS_DISTRO", "ROS_VERSION",
@@ -41,10 +41,10 @@ def student_process(script: Path, ros_args: list[str], limits: Limits, *, domain
     sibling modules in a working directory of its own, a minimal environment on ROS
     domain ``domain``, and in strict isolation a user of its own with the course hidden.
 
-    The grading (``autograder.pytest_plugin.launch``) and strict isolation's start-up check
-    (``autograder.isolation``) both start programs through here, so the check proves what
+    The grading (``autograder.plugin.launch``) and strict isolation's start-up check
+    (``autograder.sandbox.isolation``) both start programs through here, so the check proves what
     a real launch does."""
-    from autograder.isolation import Isolation, dds_env, protected_paths, student_uid
+    from autograder.sandbox.isolation import Isolation, dds_env, protected_paths, student_uid
 
     # Strict: a folder outside the grader's (0700) run folder, turned into the student's
     # own tmpfs by the launcher. Basic: a throwaway folder beside the staged copy.
@@ -195,12 +195,12 @@ class StudentProcess:
         if self.uid is not None:
             spec.update(uid=self.uid, hide=[str(p) for p in self.hide],
                         workdir=str(self.workdir), workdir_mb=self.workdir_mb)
-        command = [sys.executable, "-m", "autograder.sandbox_exec", json.dumps(spec), "--",
+        command = [sys.executable, "-m", "autograder.sandbox.launcher", json.dumps(spec), "--",
                    student_python(), str(self.script), "--ros-args", *self.ros_args]
         self.output = _Output(self.limits.output_kb * 1024)
         launcher_env = dict(self.env)
         launcher_env["PYTHONPATH"] = os.pathsep.join(
-            p for p in (str(Path(__file__).resolve().parent.parent), self.env.get("PYTHONPATH"))
+            p for p in (str(Path(__file__).resolve().parents[2]), self.env.get("PYTHONPATH"))
             if p)
         try:
             self.popen = subprocess.Popen(

@@ -16,8 +16,8 @@ from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-from autograder import gradebook
-from autograder.results import RunResult
+from autograder.commands import gradebook
+from autograder.core.results import RunResult
 
 
 def students(folder: Path, suffix: str | None = None) -> dict[str, Path]:

@@ -28,9 +28,8 @@ from typing import Any
 
 import pytest
 
-from autograder.errors import GraderError, StudentFailure
-from autograder.i18n import _, set_language
-from autograder.output import (
+from autograder.core.errors import GraderError, StudentFailure
+from autograder.core.output import (
     DETAILS_BYTES,
     LOG_TAIL_BYTES,
     LOG_TAIL_LINES,
@@ -43,6 +42,7 @@ from autograder.output import (
     message_tail,
     size_note,
 )
+from autograder.i18n import _, set_language
 
 reporter_key = pytest.StashKey["GradingReporter"]()
 credit_key = pytest.StashKey["Credit"]()
@@ -106,7 +106,7 @@ def _watch_lifeline(fd: int, reporter: GradingReporter) -> None:
         with contextlib.suppress(OSError):
             while os.read(fd, 1):
                 pass
-        from autograder.sandbox import reap_recorded
+        from autograder.sandbox.process import reap_recorded
 
         for process in list(reporter.data["processes"]):
             reap_recorded(process)
@@ -160,7 +160,7 @@ class GradingReporter:
     def write(self) -> None:
         if self.path is None:
             return
-        from autograder.signing import sign
+        from autograder.core.signing import sign
 
         tmp = self.path.with_suffix(".tmp")
         payload = json.dumps({"tests": list(self.tests.values()), "data": self.data},
@@ -192,7 +192,7 @@ class GradingReporter:
     @pytest.hookimpl(trylast=True)
     def pytest_collection_modifyitems(self, items: list[pytest.Item]) -> None:
         if self.exercise:
-            from autograder.exercise import find_exercise
+            from autograder.core.exercise import find_exercise
 
             self.hidden_default = find_exercise(self.exercise).hidden_visibility
         for item in items:
@@ -329,7 +329,7 @@ def credit(request: pytest.FixtureRequest) -> Credit:
 @pytest.fixture(scope="session")
 def exercise(pytestconfig: pytest.Config) -> Any:
     """The exercise under test (from ``--exercise``)."""
-    from autograder.exercise import find_exercise
+    from autograder.core.exercise import find_exercise
 
     name = pytestconfig.getoption("exercise")
     if not name:
@@ -341,7 +341,7 @@ def exercise(pytestconfig: pytest.Config) -> Any:
 def submission_file(pytestconfig: pytest.Config, exercise: Any,
                     tmp_path_factory: pytest.TempPathFactory) -> Path:
     """A private copy of the student's file (the reference solution when none is given)."""
-    from autograder.submission import SubmissionNotFound, locate, stage
+    from autograder.core.submission import SubmissionNotFound, locate, stage
 
     given = pytestconfig.getoption("submission")
     try:
@@ -357,8 +357,8 @@ def ros_context(pytestconfig: pytest.Config) -> Iterator[Any]:
     import rclpy
     from rclpy.context import Context
 
-    from autograder.domains import reserve_domain
-    from autograder.isolation import bring_up_loopback
+    from autograder.sandbox.domains import reserve_domain
+    from autograder.sandbox.isolation import bring_up_loopback
 
     if _strict():
         bring_up_loopback()  # the run's own network namespace starts with lo down
@@ -376,7 +376,7 @@ def ros_context(pytestconfig: pytest.Config) -> Iterator[Any]:
 
 
 def _strict() -> bool:
-    """True inside a grading run in its own namespaces (see autograder.isolation)."""
+    """True inside a grading run in its own namespaces (see autograder.sandbox.isolation)."""
     return os.environ.get("AUTOGRADER_RUN_ISOLATION") == "strict"
 
 
@@ -410,7 +410,7 @@ def world(request: pytest.FixtureRequest, exercise: Any, ros_context: Any) -> It
 @pytest.fixture(scope="module")
 def probe(ros_context: Any, world: Any) -> Iterator[Any]:
     """The grader's own node on the graph: publish, subscribe, call, set parameters."""
-    from autograder.probe import Probe
+    from autograder.plugin.probe import Probe
 
     node = Probe(ros_context, world)
     try:
@@ -524,7 +524,7 @@ def launch(request: pytest.FixtureRequest, exercise: Any, script: Path, probe: A
            world: Any, params: dict[str, Any] | None = None,
            wait_for_node: bool = True) -> StudentNode:
     """Start the student's program with ``use_sim_time:=true`` and wait for its node."""
-    from autograder.sandbox import student_process
+    from autograder.sandbox.process import student_process
 
     source = script.read_text(encoding="utf-8", errors="replace")
     try:

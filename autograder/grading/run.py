@@ -1,5 +1,5 @@
 """Grade a submission: run the exercise's tests in a child pytest, turn its report into a
-:class:`~autograder.results.RunResult`.
+:class:`~autograder.core.results.RunResult`.
 
 The tests (and the world and probe they use) run in a child process, so a crash there is
 reported as a grader fault instead of taking the CLI down, and a run past its time limit
@@ -21,14 +21,14 @@ from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
-from autograder.domains import DomainLock, NoDomain, hold_domain
-from autograder.exercise import Exercise
+from autograder.core.exercise import Exercise
+from autograder.core.output import digest, log_folder
+from autograder.core.results import RunResult, TestResult, exact
+from autograder.core.signing import Forged, verify
 from autograder.i18n import _, get_language
-from autograder.isolation import Isolation, dds_env, detect, run_prefix, student_uid
-from autograder.output import digest, log_folder
-from autograder.results import RunResult, TestResult, exact
-from autograder.sandbox import reap_recorded
-from autograder.signing import Forged, verify
+from autograder.sandbox.domains import DomainLock, NoDomain, hold_domain
+from autograder.sandbox.isolation import Isolation, dds_env, detect, run_prefix, student_uid
+from autograder.sandbox.process import reap_recorded
 
 GRADER_FAULT = "the autograder failed, tell your instructor"
 
@@ -67,7 +67,7 @@ def _run(exercise: Exercise, submission: Path | None, hidden: bool, lock: Domain
     The child inherits the domain's lock (it holds the domain as long as it lives) and the
     read end of a *lifeline* pipe whose write end only this process holds: when this
     process dies, however it dies, the child sees the pipe close and ends itself and every
-    student process it started (see ``autograder.pytest_plugin``)."""
+    student process it started (see ``autograder.plugin``)."""
     folders = [exercise.public_tests] + ([exercise.hidden_tests] if hidden else [])
     folders = [f for f in folders if f.is_dir()]
     ros_domain = lock.domain

@@ -8,11 +8,11 @@ from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-from autograder.declarative import ContentError, load_document
-from autograder.exercise import Exercise, assignments_dir, load_exercise
+from autograder.core.declarative import ContentError, load_document
+from autograder.core.exercise import Exercise, assignments_dir, load_exercise
+from autograder.core.results import RunResult, number
 from autograder.i18n import _
-from autograder.i18n_tools import Problem
-from autograder.results import RunResult, number
+from autograder.i18n.tools import Problem
 
 
 def _from(exc: ContentError) -> Problem:
@@ -77,7 +77,7 @@ def _gradings(exercise: Exercise, grade: Callable[..., RunResult]) -> list[Probl
 def validate(root: Path | None = None, *, run_gradings: bool = True, jobs: int = 2,
              progress: Callable[[str], None] | None = None) -> list[Problem]:
     """Every problem in the course tree (``root`` defaults to the course in use)."""
-    from autograder.grading import grade
+    from autograder.grading.run import grade
     from autograder.quiz.lint import lint
 
     folder = root / "assignments" if root else assignments_dir()

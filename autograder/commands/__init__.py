@@ -1,0 +1,2 @@
+"""The course-level commands behind the CLI: batch grading, releases, validation, CI
+workflows, gradebooks."""

@@ -1,0 +1,1 @@
+"""The model every other part shares: exercises, results, content files, errors, settings."""

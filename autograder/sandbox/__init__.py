@@ -1,0 +1,2 @@
+"""Running untrusted student programs: the process, its launcher, cgroups, isolation, ROS
+domains."""
