@@ -125,6 +125,7 @@ def start(exercise: str, directory: Path | None) -> None:
 
 def _run(exercise: str, submission: Path, hidden: bool, outputs: dict[str, Path | None],
          rtf: float | None, domain: int | None) -> None:
+    from autograder.core.report import RawTest
     from autograder.core.results import TestResult, exact
     from autograder.core.submission import SubmissionNotFound, locate
     from autograder.grading.run import grade
@@ -137,12 +138,12 @@ def _run(exercise: str, submission: Path, hidden: bool, outputs: dict[str, Path 
         raise UsageProblem(str(exc)) from None
     color = sys.stdout.isatty()
 
-    def progress(raw: dict) -> None:
-        score = exact(raw["max_score"]) if raw["status"] == "passed" else exact(0)
+    def progress(raw: RawTest) -> None:
+        score = exact(raw.max_score) if raw.status == "passed" else exact(0)
         click.echo(test_line(TestResult(
-            name=raw["name"], label=raw["label"], score=score,
-            max_score=exact(raw["max_score"]), status=raw["status"], message=raw["message"],
-            visibility=raw["visibility"]), color, reveal=False), err=True)
+            name=raw.name, label=raw.label, score=score, max_score=exact(raw.max_score),
+            status=raw.status, message=raw.message, visibility=raw.visibility), color,
+            reveal=False), err=True)
 
     click.echo(_("Grading {file} for {exercise} in the simulator...").format(
         file=submission, exercise=found.id), err=True)

@@ -22,11 +22,12 @@ from autograder.core.output import (
     message_tail,
     size_note,
 )
+from autograder.core.report import RawTest, output_log
 from autograder.core.results import RunResult, TestResult
 from autograder.core.signing import verify
-from autograder.grading.run import _with_output_log
 from autograder.i18n import set_language
-from autograder.plugin import GradingReporter, StudentNode, _bound
+from autograder.plugin.reporter import GradingReporter, _bound
+from autograder.plugin.student import StudentNode
 from autograder.render.html import to_html
 from autograder.sandbox.process import _Output
 
@@ -84,10 +85,11 @@ def test_clip_middle_keeps_both_ends():
 
 
 def test_a_report_entry_is_bounded():
-    entry = {"message": "m" * 1_000_000, "hint": "h", "details": "d" * 1_000_000}
+    entry = RawTest("t.py::t", "t", "T", 1, "visible", "message", message="m" * 1_000_000,
+                    hint="h", details="d" * 1_000_000)
     _bound(entry)
-    assert utf8(entry["message"]) < 10_000 and utf8(entry["details"]) < 20_000
-    assert entry["hint"] == "h"
+    assert utf8(entry.message) < 10_000 and utf8(entry.details) < 20_000
+    assert entry.hint == "h"
 
 
 def test_log_names():
@@ -133,7 +135,7 @@ def test_the_whole_log_goes_beside_the_report_once(tmp_path):
     assert [e["test"] for e in raw["data"]["log_files"]] == ["tests/test_a.py",
                                                               "tests/test_b.py::test_b"]
     assert raw["data"]["logs"]["tests/test_a.py"].endswith("RuntimeError: the end")
-    log = _with_output_log(raw, report)["output_log"]
+    log = output_log(raw["data"], report)
     assert log.startswith("==> tests/test_a.py <==\nHEAD\n")
     assert text in log and "second program" in log
 
@@ -143,7 +145,7 @@ def test_a_log_changed_after_the_run_is_left_out(tmp_path):
     reporter = GradingReporter(str(report), key=KEY)
     reporter.keep_log("tests/test_a.py", "the real output\n")
     (log_folder(report) / "001.log").write_text("the forged output\n")
-    log = _with_output_log(verify(report.read_text(), KEY), report)["output_log"]
+    log = output_log(verify(report.read_text(), KEY)["data"], report)
     assert "forged" not in log and "real" not in log
     assert "changed after your program ran" in log
 

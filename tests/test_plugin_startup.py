@@ -13,7 +13,7 @@ import dataclasses
 from collections.abc import Callable, Iterator
 from types import SimpleNamespace
 
-from autograder.plugin import StudentNode, _node_endpoints, _wait_for_node
+from autograder.plugin.student import StudentNode, _node_endpoints, _wait_for_node
 
 NAME = "obstacle_avoider"
 

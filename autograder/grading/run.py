@@ -21,13 +21,14 @@ from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
+from autograder.core import report
 from autograder.core.exercise import Exercise
-from autograder.core.output import digest, log_folder
+from autograder.core.report import RawReport, RawTest
 from autograder.core.results import RunResult, TestResult, exact
-from autograder.core.signing import Forged, verify
+from autograder.core.settings import RunSettings
 from autograder.i18n import _, get_language
 from autograder.sandbox.domains import DomainLock, NoDomain, hold_domain
-from autograder.sandbox.isolation import Isolation, dds_env, detect, run_prefix, student_uid
+from autograder.sandbox.isolation import Isolation, detect, run_prefix, student_uid
 from autograder.sandbox.process import reap_recorded
 
 GRADER_FAULT = "the autograder failed, tell your instructor"
@@ -46,11 +47,11 @@ def grade(exercise: Exercise, submission: Path | None, *, hidden: bool = True,
     isolation = detect()
     try:
         with hold_domain(domain) as lock:
-            result, report = _run(exercise, submission, hidden, lock, isolation,
+            result, raw = _run(exercise, submission, hidden, lock, isolation,
                                   real_time_factor, progress, started)
     except NoDomain as exc:
         return _fault(exercise, str(exc), time.monotonic() - started)
-    processes = report.get("data", {}).get("processes", [])
+    processes = raw.processes
     bounds = processes[0].get("bounds") if processes else None
     return dataclasses.replace(result, data={
         **result.data, "isolation": {**isolation.to_dict(), "bounds": bounds},
@@ -60,43 +61,35 @@ def grade(exercise: Exercise, submission: Path | None, *, hidden: bool = True,
 
 def _run(exercise: Exercise, submission: Path | None, hidden: bool, lock: DomainLock,
          isolation: Isolation, real_time_factor: float | None,
-         progress: Callable[[dict[str, Any]], None] | None,
-         started: float) -> tuple[RunResult, dict[str, Any]]:
+         progress: Callable[[RawTest], None] | None,
+         started: float) -> tuple[RunResult, RawReport]:
     """One grading in a child pytest on the reserved domain; the result and raw report.
 
-    The child inherits the domain's lock (it holds the domain as long as it lives) and the
-    read end of a *lifeline* pipe whose write end only this process holds: when this
-    process dies, however it dies, the child sees the pipe close and ends itself and every
-    student process it started (see ``autograder.plugin``)."""
+    The child gets its :class:`~autograder.core.settings.RunSettings` as one document. It
+    inherits the domain's lock (it holds the domain as long as it lives) and the read end
+    of a *lifeline* pipe whose write end only this process holds: when this process dies,
+    however it dies, the child sees the pipe close and ends itself and every student
+    process it started (see ``autograder.plugin``)."""
     folders = [exercise.public_tests] + ([exercise.hidden_tests] if hidden else [])
     folders = [f for f in folders if f.is_dir()]
-    ros_domain = lock.domain
     with tempfile.TemporaryDirectory(prefix="autograder-") as tmp:
         report_path = Path(tmp) / "report.json"
-        command = [
-            *run_prefix(isolation), sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
-            "--rootdir", str(exercise.folder), "--basetemp", str(Path(tmp) / "pytest"),
-            "--exercise", str(exercise.folder), "--autograder-report", str(report_path),
-            "--ros-domain", str(ros_domain), *(str(f) for f in folders),
-        ]
-        if submission is not None:
-            command += ["--submission", str(Path(submission).resolve())]
-        if real_time_factor is not None:
-            command += ["--real-time-factor", str(real_time_factor)]
-        env = dict(os.environ, AUTOGRADER_LANG=get_language(), ROS_DOMAIN_ID=str(ros_domain),
-                   AUTOGRADER_COURSE=str(exercise.folder.parent.parent),
-                   AUTOGRADER_RUN_ISOLATION=isolation.mode, PYTHONDONTWRITEBYTECODE="1")
-        for key, value in dds_env(isolation).items():
-            if value is None:
-                env.pop(key, None)
-            else:
-                env[key] = value
-        log_path = Path(tmp) / "pytest.log"
         key = secrets.token_bytes(32)
         key_read, key_write = os.pipe()
         life_read, life_write = os.pipe()
-        command += ["--autograder-report-key-fd", str(key_read),
-                    "--autograder-lifeline-fd", str(life_read)]
+        settings = RunSettings(
+            exercise=str(exercise.folder),
+            submission=str(Path(submission).resolve()) if submission is not None else None,
+            course=str(exercise.folder.parent.parent), report=str(report_path),
+            key_fd=key_read, lifeline_fd=life_read, domain=lock.domain,
+            real_time_factor=real_time_factor, isolation=isolation.mode, lang=get_language())
+        command = [
+            *run_prefix(isolation), sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
+            "--rootdir", str(exercise.folder), "--basetemp", str(Path(tmp) / "pytest"),
+            "--autograder-settings", settings.to_json(), *(str(f) for f in folders),
+        ]
+        env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1")
+        log_path = Path(tmp) / "pytest.log"
         try:
             with log_path.open("wb") as log:
                 child = subprocess.Popen(command, cwd=tmp, env=env, stdout=log,
@@ -110,13 +103,12 @@ def _run(exercise: Exercise, submission: Path | None, hidden: bool, lock: Domain
                 timed_out = _wait(child, exercise.time_limit, report_path, key, progress)
         finally:
             os.close(life_write)
-        report = _read_report(report_path, key)
-        report = _with_output_log(report, report_path)
-        _reap(child, report)
+        raw = report.read(report_path, key, with_logs=True)
+        _reap(child, raw)
         pytest_log = log_path.read_text(errors="replace")
-    result = _result(exercise, report, child.returncode, timed_out, pytest_log,
+    result = _result(exercise, raw, child.returncode, timed_out, pytest_log,
                      time.monotonic() - started, all_tests=hidden)
-    return result, report
+    return result, raw
 
 
 def _fault(exercise: Exercise, details: str, elapsed: float) -> RunResult:
@@ -128,7 +120,7 @@ def _fault(exercise: Exercise, details: str, elapsed: float) -> RunResult:
 
 
 def _wait(child: subprocess.Popen[bytes], limit: float, report_path: Path, key: bytes,
-          progress: Callable[[dict[str, Any]], None] | None) -> bool:
+          progress: Callable[[RawTest], None] | None) -> bool:
     """Wait for the pytest child, calling ``progress`` as tests finish; True if it ran over."""
     deadline = time.monotonic() + limit
     reported: set[str] = set()
@@ -139,9 +131,9 @@ def _wait(child: subprocess.Popen[bytes], limit: float, report_path: Path, key: 
         except subprocess.TimeoutExpired:
             finished = False
         if progress is not None:
-            for test in _read_report(report_path, key).get("tests", []):
-                if test.get("done") and test["nodeid"] not in reported:
-                    reported.add(test["nodeid"])
+            for test in report.read(report_path, key).tests:
+                if test.done and test.nodeid not in reported:
+                    reported.add(test.nodeid)
                     progress(test)
         if finished:
             return False
@@ -151,48 +143,13 @@ def _wait(child: subprocess.Popen[bytes], limit: float, report_path: Path, key: 
             return True
 
 
-def _read_report(path: Path, key: bytes) -> dict[str, Any]:
-    """The signed report; ``{"forged": True}`` if someone else wrote it."""
-    try:
-        text = path.read_text()
-    except OSError:
-        return {}
-    try:
-        return verify(text, key)
-    except Forged:
-        return {"forged": True}
-
-
-def _with_output_log(report: dict[str, Any], report_path: Path) -> dict[str, Any]:
-    """The report with ``output_log``: every program's kept output, from the files the
-    signed report names (read here, before the run's folder goes)."""
-    entries = report.get("data", {}).get("log_files", [])
-    if not entries:
-        return report
-    folder = log_folder(report_path)
-    parts = [f"==> {entry['test']} <==\n{_read_log(folder, entry)}" for entry in entries]
-    return {**report, "output_log": "\n\n".join(parts)}
-
-
-def _read_log(folder: Path, entry: dict[str, Any]) -> str:
-    """One program's kept output, if the file is the one the report vouches for."""
-    path = folder / Path(entry["file"]).name
-    try:  # the size first: a file swapped for a huge one is not read
-        raw = path.read_bytes() if path.stat().st_size == entry["bytes"] else b""
-    except OSError:
-        raw = b""
-    if digest(raw) != entry["sha256"]:
-        return _("(This output was changed after your program ran, so it is left out.)")
-    return raw.decode("utf-8", "replace")
-
-
-def _reap(child: subprocess.Popen[bytes], report: dict[str, Any]) -> None:
+def _reap(child: subprocess.Popen[bytes], raw: RawReport) -> None:
     """Make sure nothing the run started outlives it (the child's group, students' cgroups)."""
     try:
         os.killpg(child.pid, signal.SIGKILL)
     except (ProcessLookupError, PermissionError):
         pass
-    for process in report.get("data", {}).get("processes", []):
+    for process in raw.processes:
         reap_recorded(process)
 
 
@@ -218,29 +175,28 @@ def _forged(exercise: Exercise, elapsed: float) -> RunResult:
                      execution_time=elapsed, data={"forged": True})
 
 
-def _result(exercise: Exercise, report: dict[str, Any], returncode: int | None,
+def _result(exercise: Exercise, raw_report: RawReport, returncode: int | None,
             timed_out: bool, pytest_log: str, elapsed: float,
             all_tests: bool = True) -> RunResult:
-    if report.get("forged"):
+    if raw_report.forged:
         return _forged(exercise, elapsed)
     tests = []
     errors = []
-    for raw in report.get("tests", []):
-        status = raw["status"]
-        max_score = exact(raw["max_score"])
-        message = raw["message"]
-        if timed_out and status == "error" and not raw.get("done"):
+    for raw in raw_report.tests:
+        status = raw.status
+        max_score = exact(raw.max_score)
+        message = raw.message
+        if timed_out and status == "error" and not raw.done:
             status, message = "failed", _(
                 "Not run: grading stopped at its time limit of {seconds:.0f} s.").format(
                 seconds=exercise.time_limit)
         if status == "error":
-            errors.append(f"{raw['name']}: {message}\n{raw.get('details', '')}")
+            errors.append(f"{raw.name}: {message}\n{raw.details}")
         tests.append(TestResult(
-            name=raw["name"], label=raw["label"],
-            score=_score(status, max_score, raw.get("fraction")), max_score=max_score,
-            status=status, message=message, hint=raw.get("hint", ""),
-            visibility=raw["visibility"], reveal=raw.get("reveal", "message"),
-            details=raw.get("details", ""), data={"charts": raw.get("charts", [])}))
+            name=raw.name, label=raw.label,
+            score=_score(status, max_score, raw.fraction), max_score=max_score,
+            status=status, message=message, hint=raw.hint, visibility=raw.visibility,
+            reveal=raw.reveal, details=raw.details, data={"charts": raw.charts}))
     grader_error = None
     details = ""
     broken_run = returncode not in (0, 1) and not timed_out  # e.g. a test file that
@@ -255,13 +211,13 @@ def _result(exercise: Exercise, report: dict[str, Any], returncode: int | None,
         grader_error = GRADER_FAULT
         details = (f"{exercise.folder / 'exercise.yaml'}: points is {exercise.points} but the "
                    f"tests add up to {total}")
-    data = report.get("data", {})
+    data = raw_report.data
     logs = data.get("logs", {})
     return RunResult(
         kind="exercise", id=exercise.id, title=exercise.localized_title, tests=tuple(tests),
         pass_mark=exercise.pass_fraction, lang=get_language(), grader_error=grader_error,
         grader_details=details, log_tail="\n".join(logs.values())[-4000:],
-        log=report.get("output_log", ""),
+        log=raw_report.output_log,
         execution_time=elapsed,
         data={"recordings": data.get("recordings", {}), "timed_out": timed_out,
               "startup_seconds": data.get("startup_seconds", []),

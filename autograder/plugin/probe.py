@@ -26,6 +26,10 @@ from autograder.i18n import _
 M = TypeVar("M")
 
 PROBE_NODE_NAME = "autograder_probe"
+# The world's node, as the grader names it (sim.bridge.SimBridge's node_name).
+WORLD_NODE_NAME = "sim_world"
+# Names only the grader's own nodes may carry (the tampering guard checks them).
+GRADER_NODES = (PROBE_NODE_NAME, WORLD_NODE_NAME)
 
 
 class Inbox(Generic[M]):

@@ -1,0 +1,42 @@
+"""What the grader tells the pytest child that runs one grading, as one document.
+
+The grader (:mod:`autograder.grading.run`) writes a :class:`RunSettings` as JSON into the
+child's single ``--autograder-settings`` option; the plugin (:mod:`autograder.plugin`)
+reads it back. An instructor running an exercise's tests by hand gives the same settings
+as ordinary options (``--exercise``, ``--submission``, ``--ros-domain``,
+``--real-time-factor``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from typing import Literal
+
+
+@dataclasses.dataclass(frozen=True)
+class RunSettings:
+    """One grading run, as its pytest child needs to know it."""
+
+    exercise: str  # the exercise's folder (or id, by hand)
+    submission: str | None = None  # the student's file or folder; None: the solution
+    course: str | None = None  # the course tree (becomes AUTOGRADER_COURSE in the child)
+    report: str | None = None  # where the child writes the signed raw report
+    key_fd: int | None = None  # a pipe holding the report's signing key
+    lifeline_fd: int | None = None  # a pipe that closes when the grader dies
+    domain: int | None = None  # the ROS domain the grader reserved; None: reserve one
+    real_time_factor: float | None = None  # overrides the exercise's
+    isolation: Literal["strict", "basic"] = "basic"  # as the grader chose it
+    lang: str = "en"
+
+    @property
+    def strict(self) -> bool:
+        return self.isolation == "strict"
+
+    def to_json(self) -> str:
+        return json.dumps(dataclasses.asdict(self))
+
+    @classmethod
+    def from_json(cls, text: str) -> RunSettings:
+        fields = {f.name for f in dataclasses.fields(cls)}
+        return cls(**{k: v for k, v in json.loads(text).items() if k in fields})

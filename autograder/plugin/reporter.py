@@ -1,0 +1,167 @@
+"""The reporter: each test's outcome, points and message, in the raw report as the run
+goes (registered by :mod:`autograder.plugin` only when an exercise is graded)."""
+
+from __future__ import annotations
+
+import traceback
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from autograder.core import report
+from autograder.core.errors import GraderError, StudentFailure
+from autograder.core.output import (
+    DETAILS_BYTES,
+    LOG_TAIL_BYTES,
+    LOG_TAIL_LINES,
+    MESSAGE_BYTES,
+    clip_middle,
+    message_tail,
+)
+from autograder.core.report import RawTest
+from autograder.i18n import _
+from autograder.plugin.stash import credit_key, evidence_key
+
+
+def _label(item: pytest.Item) -> str:
+    doc = getattr(getattr(item, "function", None), "__doc__", None) or item.name
+    return _(doc.strip().splitlines()[0].strip())
+
+
+def _reveal(item: pytest.Item, visibility: str) -> str:
+    """What a student sees of a test: 'message' (all) or 'status' (label and pass/fail)."""
+    marker = item.get_closest_marker("reveal")
+    if marker and marker.args:
+        return str(marker.args[0])
+    return "message" if visibility == "visible" else "status"
+
+
+def _visibility(item: pytest.Item, hidden_default: str) -> str:
+    marker = item.get_closest_marker("visibility")
+    if marker and marker.args:
+        return str(marker.args[0])
+    return hidden_default if "hidden" in Path(str(item.path)).parts else "visible"
+
+
+class GradingReporter:
+    """Collects each test's outcome, points and message; writes the raw report as it goes."""
+
+    def __init__(self, path: str | None, exercise: str | None = None,
+                 key: bytes = b"") -> None:
+        self.path = Path(path) if path else None
+        self.exercise = exercise
+        self.key = key
+        self.tests: dict[str, RawTest] = {}
+        self.data: dict[str, Any] = {"logs": {}, "log_files": [], "recordings": {},
+                                     "processes": []}
+        self.hidden_default = "after_published"
+
+    def write(self) -> None:
+        if self.path is not None:
+            report.write(self.path, list(self.tests.values()), self.data, self.key)
+
+    def keep_log(self, nodeid: str, text: str) -> None:
+        """Keep a stopped program's output: its end in the report, the whole of it (as the
+        sandbox kept it) in a file of its own that the report names with its digest, so
+        the report, re-written after every test, stays small."""
+        self.data["logs"][nodeid] = message_tail(text, LOG_TAIL_LINES, LOG_TAIL_BYTES)
+        if self.path is not None and text:
+            report.keep_log(self.path, self.data, nodeid, text)
+        self.write()
+
+    def note_process(self, pid: int, cgroups: list[str], bounds: dict[str, Any]) -> None:
+        """Record a student process so the parent can reap it if this run is killed, and
+        say which bounds held it."""
+        self.data["processes"].append({"pid": pid, "cgroups": cgroups, "bounds": bounds})
+        self.write()
+
+    @pytest.hookimpl(trylast=True)
+    def pytest_collection_modifyitems(self, items: list[pytest.Item]) -> None:
+        if self.exercise:
+            from autograder.core.exercise import find_exercise
+
+            self.hidden_default = find_exercise(self.exercise).hidden_visibility
+        for item in items:
+            from autograder.plugin import marker_problem
+
+            marker = item.get_closest_marker("points")
+            points = marker.args[0] if marker and marker.args else 1
+            if marker_problem(item) is not None:
+                points = 1  # the test errs at setup, naming the problem
+            visibility = _visibility(item, self.hidden_default)
+            self.tests[item.nodeid] = RawTest(
+                nodeid=item.nodeid, name=item.name, label=_label(item),
+                max_score=points,
+                visibility=visibility, reveal=_reveal(item, visibility),
+                message=_("Not run: the grading run ended before this test."))
+        self.write()
+
+    @pytest.hookimpl(hookwrapper=True)
+    def pytest_runtest_makereport(self, item: pytest.Item,
+                                  call: pytest.CallInfo[None]) -> Iterator[None]:
+        outcome = yield
+        outcome_report = outcome.get_result()
+        entry = self.tests.get(item.nodeid)
+        if entry is None:
+            return
+        shown = item.stash.get(evidence_key, None)
+        if shown is not None and call.when == "call":
+            entry.charts = shown.charts
+        if call.when == "setup" or call.when == "call":
+            given = item.stash.get(credit_key, None)
+            if outcome_report.passed and call.when == "call" and given \
+                    and given.fraction is not None and given.fraction < 1:
+                _update(entry, status="failed", fraction=given.fraction,
+                        message=given.message, hint=given.hint)
+            elif outcome_report.passed and call.when == "call":
+                _update(entry, status="passed", message="", hint="")
+            elif outcome_report.skipped:
+                _update(entry, status="skipped", message=_skip_reason(outcome_report))
+            elif outcome_report.failed:
+                _update(entry, **_classify(call.excinfo))
+        elif call.when == "teardown" and outcome_report.failed and entry.status == "passed":
+            _update(entry, **_classify(call.excinfo))
+        _bound(entry)
+
+    def pytest_runtest_logfinish(self, nodeid: str) -> None:
+        if nodeid in self.tests:
+            self.tests[nodeid].done = True
+        self.write()
+
+
+def _update(entry: RawTest, **values: Any) -> None:
+    for key, value in values.items():
+        setattr(entry, key, value)
+
+
+def _bound(entry: RawTest) -> None:
+    """Cut what a test reports to a few KB: every results format repeats it per test."""
+    entry.message = clip_middle(entry.message, MESSAGE_BYTES)
+    entry.hint = clip_middle(entry.hint, MESSAGE_BYTES)
+    entry.details = clip_middle(entry.details, DETAILS_BYTES)
+
+
+def _skip_reason(report: pytest.TestReport) -> str:
+    longrepr = report.longrepr
+    if isinstance(longrepr, tuple) and len(longrepr) == 3:
+        return str(longrepr[2]).removeprefix("Skipped: ")
+    return str(longrepr)
+
+
+def _classify(excinfo: pytest.ExceptionInfo[BaseException] | None) -> dict[str, str]:
+    """A failing test's status: the student's failure, or our error."""
+    if excinfo is None:
+        return {"status": "failed", "message": "", "hint": "", "details": ""}
+    details = "".join(traceback.format_exception(excinfo.type, excinfo.value, excinfo.tb))
+    error = excinfo.value
+    if isinstance(error, StudentFailure):
+        return {"status": "failed", "message": error.message, "hint": error.hint,
+                "details": details}
+    if isinstance(error, AssertionError):
+        text = str(error).strip()
+        return {"status": "failed", "message": text.split("\nassert")[0].strip() or
+                _("A check failed."), "hint": "", "details": details}
+    kind = "grader error" if isinstance(error, GraderError) else type(error).__name__
+    return {"status": "error", "message": f"{kind}: {error}", "hint": "", "details": details}

@@ -1,0 +1,20 @@
+"""Where the plugin keeps its state on pytest's config and items (``config.stash``)."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import pytest
+
+from autograder.core.errors import StudentFailure
+from autograder.core.settings import RunSettings
+
+if TYPE_CHECKING:
+    pass
+
+settings_key = pytest.StashKey[RunSettings]()
+reporter_key = pytest.StashKey["GradingReporter"]()
+credit_key = pytest.StashKey["Credit"]()
+evidence_key = pytest.StashKey["Evidence"]()
+# The student's node failed to appear once: later starts in the run fail at once.
+startup_key = pytest.StashKey[StudentFailure]()

@@ -1,0 +1,118 @@
+"""The fixtures of the graph a test runs on: the exercise, the student's staged file, the
+run's rclpy context, the simulated world and the grader's probe node."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+from collections.abc import Iterator
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import pytest
+
+from autograder.core.errors import StudentFailure
+from autograder.plugin.probe import WORLD_NODE_NAME
+from autograder.plugin.stash import reporter_key, settings_key
+
+if TYPE_CHECKING:
+    from rclpy.context import Context
+
+    from autograder.core.exercise import Exercise
+    from autograder.plugin.probe import Probe
+    from sim.bridge import SimBridge
+
+
+@pytest.fixture(scope="session")
+def exercise(pytestconfig: pytest.Config) -> Exercise:
+    """The exercise under test (from the run's settings, or ``--exercise``)."""
+    from autograder.core.exercise import find_exercise
+
+    settings = pytestconfig.stash.get(settings_key, None)
+    if settings is None:
+        pytest.skip("run with --exercise to use the autograder fixtures")
+    return find_exercise(settings.exercise)
+
+
+@pytest.fixture(scope="session")
+def submission_file(pytestconfig: pytest.Config, exercise: Exercise,
+                    tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A private copy of the student's file (the reference solution when none is given)."""
+    from autograder.core.submission import SubmissionNotFound, locate, stage
+
+    given = pytestconfig.stash[settings_key].submission
+    try:
+        source = locate(Path(given), exercise.file) if given else exercise.solution
+    except SubmissionNotFound as exc:
+        raise StudentFailure(str(exc)) from None
+    return stage(source, exercise.file, tmp_path_factory.mktemp("submission"))
+
+
+@pytest.fixture(scope="session")
+def ros_context(pytestconfig: pytest.Config) -> Iterator[Context]:
+    """An rclpy context on this run's own ROS domain (the grader's, or one reserved here),
+    with the middleware set for the run's isolation."""
+    import rclpy
+    from rclpy.context import Context
+
+    from autograder.sandbox.domains import reserve_domain
+    from autograder.sandbox.isolation import Isolation, bring_up_loopback, dds_env
+
+    settings = pytestconfig.stash[settings_key]
+    if settings.strict:
+        bring_up_loopback()  # the run's own network namespace starts with lo down
+    for key, value in dds_env(Isolation(settings.strict)).items():
+        if value is None:
+            os.environ.pop(key, None)
+        else:
+            os.environ[key] = value
+    given = settings.domain
+    with reserve_domain(None) if given is None else contextlib.nullcontext(given) as domain:
+        os.environ["ROS_DOMAIN_ID"] = str(domain)
+        context = Context()
+        rclpy.init(context=context, domain_id=domain)
+        try:
+            yield context
+        finally:
+            rclpy.try_shutdown(context=context)
+
+
+@pytest.fixture(scope="module")
+def world(request: pytest.FixtureRequest, exercise: Exercise,
+          ros_context: Context) -> Iterator[SimBridge]:
+    """The simulated world, running, for this test module (``@pytest.mark.world`` picks it)."""
+    from sim.bridge import SimBridge
+    from sim.physics import World
+    from sim.worldfile import load_world
+
+    marker = request.node.get_closest_marker("world")
+    name = marker.args[0] if marker and marker.args else exercise.world
+    local = exercise.folder / name
+    spec = load_world(local if local.suffix in (".yaml", ".yml") and local.exists() else name)
+    rtf = request.config.stash[settings_key].real_time_factor
+    bridge = SimBridge(World(spec), ros_context, node_name=WORLD_NODE_NAME,
+                       max_clock_hz=exercise.clock_hz,
+                       cpu_budget=exercise.cpu_budget,
+                       real_time_factor=exercise.real_time_factor if rtf is None else rtf)
+    bridge.start()
+    try:
+        yield bridge
+    finally:
+        bridge.stop()
+        reporter = request.config.stash.get(reporter_key, None)
+        if reporter is not None:
+            reporter.data["recordings"][request.node.name] = bridge.recording.to_dict()
+            reporter.data.setdefault("pacing", {})[request.node.name] = {
+                **bridge.pacing, "longest_hold": round(bridge.longest_hold, 3)}
+
+
+@pytest.fixture(scope="module")
+def probe(ros_context: Context, world: SimBridge) -> Iterator[Probe]:
+    """The grader's own node on the graph: publish, subscribe, call, set parameters."""
+    from autograder.plugin.probe import Probe
+
+    node = Probe(ros_context, world)
+    try:
+        yield node
+    finally:
+        node.close()
