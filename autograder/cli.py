@@ -156,34 +156,30 @@ def _run(exercise: str, submission: Path, hidden: bool, outputs: dict[str, Path 
 
 
 def write_outputs(result, outputs: dict[str, Path | None], folder: Path) -> None:  # noqa: ANN001
-    """Write each requested format of ``result`` (``--results``, ``--html``, ...); with
-    ``--results FILE``, the programs' whole output goes to FILE with suffix ``.log``
-    (``log`` names another file for it)."""
+    """Write each requested output format of ``result`` (``--results``, ``--html``, ...:
+    see :mod:`autograder.render`); with ``--results FILE``, the programs' whole output goes
+    to FILE with suffix ``.log`` (``log`` names another file for it)."""
     from autograder.core.output import log_beside
-    from autograder.render.gradescope import to_gradescope
-    from autograder.render.html import to_html
-    from autograder.render.jsonfile import to_json
-    from autograder.render.junit import to_junit
+    from autograder.render import formats
 
-    renderers = {"results": to_json, "gradescope": to_gradescope, "junit": to_junit,
-                 "html": lambda r: to_html(r, folder), "log": lambda r: r.log}
     outputs = dict(outputs)
     if outputs.get("results") is not None and result.kind == "exercise":
         outputs.setdefault("log", log_beside(outputs["results"]))
     for name, path in outputs.items():
-        if path is not None:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            path.write_text(renderers[name](result), encoding="utf-8")
+        if path is None:
+            continue
+        path.parent.mkdir(parents=True, exist_ok=True)
+        text = result.log if name == "log" else formats()[name].render(result, folder)
+        path.write_text(text, encoding="utf-8")
 
 
 def _formats(func):  # noqa: ANN001, ANN202
-    """``--results``, ``--gradescope``, ``--junit`` and ``--html`` FILE options."""
-    for name, text in (("html", "Write a self-contained HTML report to this file."),
-                       ("junit", "Write JUnit XML to this file."),
-                       ("gradescope", "Write Gradescope's results.json to this file."),
-                       ("results", "Write the results as JSON to this file.")):
-        func = click.option(f"--{name}", type=click.Path(path_type=Path, dir_okay=False),
-                            help=text)(func)
+    """A ``--NAME FILE`` option per output format (autograder.render)."""
+    from autograder.render import formats
+
+    for found in reversed(formats().values()):
+        func = click.option(f"--{found.name}", type=click.Path(path_type=Path, dir_okay=False),
+                            help=found.help)(func)
     return func
 
 
@@ -295,6 +291,7 @@ def _batch_item(item: str):  # noqa: ANN202
     from autograder.grading.run import grade
     from autograder.quiz.catalog import find_quiz
     from autograder.quiz.scoring import AnswersError, read_answers, score
+    from autograder.render import formats
 
     try:
         exercise = _exercise(item)
@@ -302,9 +299,11 @@ def _batch_item(item: str):  # noqa: ANN202
         exercise = None
     if exercise is not None:
         def extra(result, folder: Path) -> None:  # noqa: ANN001
-            write_outputs(result, {"html": folder / "report.html",
-                                   "gradescope": folder / "gradescope.json",
-                                   "log": folder / "output.log"}, exercise.folder)
+            # Every format with a file per student; results.json is the batch's own
+            # (written last: it marks the student done).
+            files = {f.name: folder / f.batch_file for f in formats().values()
+                     if f.batch_file and f.name != "results"}
+            write_outputs(result, {**files, "log": folder / "output.log"}, exercise.folder)
 
         return (lambda path: grade(exercise, path)), None, extra
     try:

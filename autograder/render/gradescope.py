@@ -7,6 +7,7 @@ from typing import Any
 
 from autograder.core.results import RunResult, TestResult, number
 from autograder.i18n import _
+from autograder.render import OutputFormat
 
 # Gradescope's visibility values; our "hidden" tests follow the exercise's setting.
 _VISIBILITY = {"visible": "visible", "hidden": "hidden", "after_published": "after_published"}
@@ -50,3 +51,8 @@ def to_gradescope_dict(result: RunResult) -> dict[str, Any]:
 
 def to_gradescope(result: RunResult) -> str:
     return json.dumps(to_gradescope_dict(result), ensure_ascii=False, indent=2) + "\n"
+
+
+FORMAT = OutputFormat(
+    "gradescope", "Write Gradescope's results.json to this file.",
+    lambda result, _folder: to_gradescope(result), batch_file="gradescope.json", order=30)

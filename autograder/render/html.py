@@ -18,6 +18,7 @@ from autograder.core.results import RunResult, number
 from autograder.i18n import is_rtl
 from autograder.quiz.localize import Text, format_percent, using_language
 from autograder.quiz.render import environment
+from autograder.render import OutputFormat
 from autograder.render.charts import intervals_svg
 
 
@@ -69,3 +70,8 @@ def _render(result: RunResult, tests: list[dict[str, Any]], exercise_folder: Pat
         percent=format_percent(result.fraction, lang),
         pass_mark=format_percent(result.pass_mark, lang),
         pictures=_trajectories(result, exercise_folder))
+
+
+FORMAT = OutputFormat(
+    "html", "Write a self-contained HTML report to this file.", to_html,
+    batch_file="report.html", order=20)

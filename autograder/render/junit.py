@@ -5,6 +5,7 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 
 from autograder.core.results import RunResult, number
+from autograder.render import OutputFormat
 
 
 def to_junit(result: RunResult) -> str:
@@ -45,3 +46,8 @@ def to_junit(result: RunResult) -> str:
         ET.SubElement(suite, "system-out").text = result.log_tail
     ET.indent(suites)
     return ET.tostring(suites, encoding="unicode", xml_declaration=True) + "\n"
+
+
+FORMAT = OutputFormat(
+    "junit", "Write JUnit XML to this file.", lambda result, _folder: to_junit(result),
+    order=40)
