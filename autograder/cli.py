@@ -14,23 +14,12 @@ from pathlib import Path
 import click
 
 from autograder import __version__
+from autograder.commands.exits import GraderFault, ProblemsFound, UsageProblem
 from autograder.core.declarative import ContentError
 from autograder.i18n import LANGUAGES, _, get_language, ngettext, set_language
 from autograder.i18n.cli import i18n_cli
 from autograder.quiz.cli import quiz_cli
 from sim.cli import sim_cli
-
-
-class UsageProblem(click.ClickException):
-    """Bad input from the user: one line naming the file and what is wrong."""
-
-    exit_code = 2
-
-
-class GraderFault(click.ClickException):
-    """The autograder failed: not the student's fault."""
-
-    exit_code = 3
 
 
 @click.group()
@@ -381,15 +370,9 @@ def validate(run_gradings: bool, jobs: int, course: Path | None) -> None:
     for problem in problems:
         click.echo(str(problem), err=True)
     if problems:
-        raise Problems(ngettext("{count} problem found", "{count} problems found",
+        raise ProblemsFound(ngettext("{count} problem found", "{count} problems found",
                                 len(problems)).format(count=len(problems)))
     click.echo(_("The course is valid."))
-
-
-class Problems(click.ClickException):
-    """Validation found problems (each printed as file:line: message)."""
-
-    exit_code = 1
 
 
 main.add_command(sim_cli, "sim")

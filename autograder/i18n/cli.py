@@ -11,10 +11,10 @@ from pathlib import Path
 
 import click
 
+from autograder.commands.exits import ProblemsFound, UsageProblem
 from autograder.core.course import course_root
 from autograder.i18n import LANGUAGES, _, locales_dir, ngettext
 from autograder.i18n.tools import CatalogError, check_catalog, compile_catalogs, extract, update
-from autograder.quiz.errors import ContentFileError, LintFailed
 
 _TARGETS = tuple(lang for lang in LANGUAGES if lang != "en")
 
@@ -38,7 +38,7 @@ def extract_command() -> None:
         for path in extract(course_root(), locales_dir()):
             click.echo(_("wrote {path}").format(path=_relative(path)))
     except CatalogError as exc:
-        raise ContentFileError(str(exc)) from None
+        raise UsageProblem(str(exc)) from None
 
 
 @i18n_cli.command("update")
@@ -50,7 +50,7 @@ def update_command(langs: tuple[str, ...]) -> None:
         for path in update(locales_dir(), langs):
             click.echo(_("updated {path}").format(path=_relative(path)))
     except CatalogError as exc:
-        raise ContentFileError(str(exc)) from None
+        raise UsageProblem(str(exc)) from None
 
 
 @i18n_cli.command("compile")
@@ -60,7 +60,7 @@ def compile_command() -> None:
         for path in compile_catalogs(locales_dir()):
             click.echo(_("compiled {path}").format(path=_relative(path)))
     except CatalogError as exc:
-        raise ContentFileError(str(exc)) from None
+        raise UsageProblem(str(exc)) from None
 
 
 @i18n_cli.command("check")
@@ -77,6 +77,6 @@ def check_command(langs: tuple[str, ...]) -> None:
     for p in problems:
         click.echo(str(p), err=True)
     if problems:
-        raise LintFailed(ngettext("{count} problem found", "{count} problems found",
+        raise ProblemsFound(ngettext("{count} problem found", "{count} problems found",
                                   len(problems)).format(count=len(problems)))
     click.echo(_("All catalogs are complete."))

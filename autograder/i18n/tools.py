@@ -20,6 +20,7 @@ from babel.messages.frontend import parse_mapping_cfg
 from babel.messages.mofile import write_mo
 from babel.messages.pofile import PoFileError, read_po, write_po
 
+from autograder.core.declarative import ContentError
 from autograder.i18n import _
 
 PLATFORM_DOMAIN = "messages"
@@ -33,16 +34,8 @@ _PLACEHOLDER = re.compile(r"\{[A-Za-z_][\w]*(?:![rsa])?(?::[^{}]*)?\}|%\(\w+\)[s
 _CODE = re.compile(r"`[^`]+`")
 
 
-class CatalogError(Exception):
-    """A malformed catalog or mapping file: names the file and the line."""
-
-    def __init__(self, path: Path | str, message: str, line: int | None = None) -> None:
-        self.path, self.message, self.line = Path(path), message, line
-        super().__init__(str(self))
-
-    def __str__(self) -> str:
-        where = f"{self.path}:{self.line}" if self.line else str(self.path)
-        return f"{where}: {self.message}"
+# A malformed catalog or mapping file is the one path:line content error.
+CatalogError = ContentError
 
 
 @dataclasses.dataclass(frozen=True)

@@ -1,0 +1,30 @@
+"""The exit codes of every ``autograder`` command, as click exceptions: each prints one
+plain line (naming the file and line where there is one), never a traceback.
+
+0 when the command completed (a grading or scoring, whatever the score); 1 when a check
+(``quiz lint``, ``i18n check``, ``validate``) found problems, each already printed as
+``file:line: message``; 2 for bad input (a malformed or missing file, an unknown exercise
+or quiz, a port in use); 3 when the autograder itself failed.
+"""
+
+from __future__ import annotations
+
+import click
+
+
+class ProblemsFound(click.ClickException):
+    """A check found problems (each already printed as ``file:line: message``)."""
+
+    exit_code = 1
+
+
+class UsageProblem(click.ClickException):
+    """Bad input from the user: one line naming the file and what is wrong."""
+
+    exit_code = 2
+
+
+class GraderFault(click.ClickException):
+    """The autograder failed: not the student's fault."""
+
+    exit_code = 3
