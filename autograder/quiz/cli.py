@@ -28,24 +28,17 @@ from autograder.i18n import (
 from autograder.i18n.tools import CatalogError, read_catalog
 from autograder.quiz import CONTENT_DOMAIN
 from autograder.quiz.catalog import find_quiz, list_quizzes, load_all
-from autograder.quiz.errors import AnswersFileError, ContentFileError, LintFailed, ServeError
+from autograder.quiz.errors import ContentFileError, LintFailed, ServeError
 from autograder.quiz.localize import Localizer, format_number, format_percent, terminal
 from autograder.quiz.model import Quiz
 from autograder.quiz.render import question_views, render_markdown, render_page
-from autograder.quiz.scoring import (
-    AnswersError,
-    key_answers,
-    pass_summary,
-    read_answers,
-    result_dict,
-    score,
-)
+from autograder.quiz.scoring import key_answers, pass_summary, read_answers, result_dict, score
 
 F = TypeVar("F", bound=Callable[..., Any])
 
 
 def _errors(func: F) -> F:
-    """Turn our error types into one-line ClickExceptions."""
+    """Turn a bad quiz, answers or catalog file into a one-line ClickException."""
 
     @functools.wraps(func)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
@@ -53,8 +46,6 @@ def _errors(func: F) -> F:
             return func(*args, **kwargs)
         except (ContentError, CatalogError) as exc:
             raise ContentFileError(str(exc)) from None
-        except AnswersError as exc:
-            raise AnswersFileError(str(exc)) from None
 
     return wrapper  # type: ignore[return-value]
 

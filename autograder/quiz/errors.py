@@ -11,13 +11,7 @@ import click
 
 
 class ContentFileError(click.ClickException):
-    """A quiz, exercise or catalog file is malformed, or a quiz id is unknown."""
-
-    exit_code = 2
-
-
-class AnswersFileError(click.ClickException):
-    """An answers file is not valid JSON, answers another quiz or names unknown ids."""
+    """A quiz, exercise, catalog or answers file is malformed, or a quiz id is unknown."""
 
     exit_code = 2
 

@@ -16,11 +16,12 @@ from urllib.parse import parse_qs, urlsplit
 
 from markupsafe import escape
 
+from autograder.core.declarative import ContentError
 from autograder.i18n import LANGUAGES, _
 from autograder.quiz.localize import using_language
 from autograder.quiz.model import Quiz, QuizFile
 from autograder.quiz.render import render_index, render_page, render_result
-from autograder.quiz.scoring import AnswersError, check_answers, score
+from autograder.quiz.scoring import check_answers, score
 
 HOST = "127.0.0.1"
 _DIGITS = str.maketrans("۰۱۲۳۴۵۶۷۸۹٠١٢٣٤٥٦٧٨٩٫", "01234567890123456789.")
@@ -134,7 +135,7 @@ class _Handler(BaseHTTPRequestHandler):
                                                          "answers": form_answers(quiz, form)})
                 result = score(quiz, answers, lang)
                 self._send(HTTPStatus.OK, render_result(quiz, result, answers, seed))
-            except AnswersError as exc:
+            except ContentError as exc:
                 self._error(HTTPStatus.BAD_REQUEST, exc.message, lang)
             except Exception:
                 traceback.print_exc()
