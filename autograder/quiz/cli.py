@@ -31,8 +31,9 @@ from autograder.quiz.catalog import find_quiz, list_quizzes, load_all
 from autograder.quiz.errors import ContentFileError, LintFailed, ServeError
 from autograder.quiz.localize import Localizer, format_number, format_percent, terminal
 from autograder.quiz.model import Quiz
-from autograder.quiz.render import question_views, render_markdown, render_page
+from autograder.quiz.render import render_markdown, render_page
 from autograder.quiz.scoring import key_answers, pass_summary, read_answers, result_dict, score
+from autograder.quiz.views import question_views
 
 F = TypeVar("F", bound=Callable[..., Any])
 
