@@ -1,7 +1,8 @@
 """What a student receives: an HTML page, a Markdown/MDX export, terminal text.
 
 Everything here is built from *views* that carry no answer key (``question_views``), so
-no renderer can leak it.  HTML comes from autoescaped Jinja2 templates.
+no renderer can leak it.  HTML comes from autoescaped Jinja2 templates; what is particular
+to a question type (its inputs, its Markdown) comes from the type.
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ from autograder.quiz.localize import (
 )
 from autograder.quiz.model import Quiz
 from autograder.quiz.scoring import pass_summary
+from autograder.quiz.types import question_type
 from autograder.quiz.views import question_views
 
 FONT_STACK_UR = ('"Noto Nastaliq Urdu", "Jameel Noori Nastaleeq", "Urdu Typesetting", '
@@ -132,17 +134,7 @@ def render_markdown(quiz: Quiz, lang: str, seed: str | int | None = None) -> str
                 block = ["```python", q.code, "```"]
                 lines += (['<div dir="ltr">', "", *block, "", "</div>"] if rtl else block)
                 lines.append("")
-            if q.type == "numeric":
-                unit = f" {markdown_inline(q.unit)}" if q.unit else ""
-                lines += [f"{_('Answer:')} \\_\\_\\_\\_\\_\\_{unit}", ""]
-            elif q.type == "ordering":
-                lines += [_("Put these in order:"), ""]
-                lines += [f"- [ ] {markdown_inline(o.text)}" for o in q.options] + [""]
-            else:
-                mark = "☐" if q.type == "multiple" else "○"
-                if q.type == "multiple":
-                    lines += [_("Choose all that apply."), ""]
-                lines += [f"- {mark} {markdown_inline(o.text)}" for o in q.options] + [""]
+            lines += question_type(q.type).markdown_lines(q)
         if rtl:
             lines += ["</div>", ""]
         return "\n".join(lines)

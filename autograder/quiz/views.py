@@ -1,17 +1,16 @@
 """A question as a student sees it: no key, options in this attempt's order.
 
 Every renderer (the HTML page, the Markdown export, the terminal) works from these views,
-so none can leak the key.
+so none can leak the key; each question's type decides its options.
 """
 
 from __future__ import annotations
 
 import dataclasses
 
-from autograder.i18n import _
 from autograder.quiz.localize import Localizer, Text
 from autograder.quiz.model import Quiz
-from autograder.quiz.shuffle import option_order
+from autograder.quiz.types import question_type
 
 
 @dataclasses.dataclass(frozen=True)
@@ -38,12 +37,8 @@ def question_views(quiz: Quiz, lang: str, seed: str | int | None) -> list[Questi
     loc = Localizer(quiz, lang)
     views = []
     for n, q in enumerate(quiz.questions, 1):
-        if q.type == "true_false":
-            options = (OptionView("true", Text(_("True"), lang)),
-                       OptionView("false", Text(_("False"), lang)))
-        else:
-            options = tuple(OptionView(o.id, loc.option(q, o))
-                            for o in option_order(quiz, q, seed))
+        kind = question_type(q.type)
         views.append(QuestionView(n, q.id, q.type, loc.text(q, "text"), q.code.rstrip(),
-                                  loc.text(q, "unit") if q.unit else None, q.points, options))
+                                  loc.text(q, "unit") if q.unit else None, q.points,
+                                  kind.option_views(quiz, q, seed, loc)))
     return views
