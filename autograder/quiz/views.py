@@ -31,6 +31,7 @@ class QuestionView:
     unit: Text | None
     points: int
     options: tuple[OptionView, ...]
+    form_template: str
 
 
 def question_views(quiz: Quiz, lang: str, seed: str | int | None) -> list[QuestionView]:
@@ -40,5 +41,5 @@ def question_views(quiz: Quiz, lang: str, seed: str | int | None) -> list[Questi
         kind = question_type(q.type)
         views.append(QuestionView(n, q.id, q.type, loc.text(q, "text"), q.code.rstrip(),
                                   loc.text(q, "unit") if q.unit else None, q.points,
-                                  kind.option_views(quiz, q, seed, loc)))
+                                  kind.option_views(quiz, q, seed, loc), kind.form_template))
     return views

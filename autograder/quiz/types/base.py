@@ -1,7 +1,8 @@
 """What every question type provides, and the checks and parsers the shipped types share.
 
 A type is the only place that knows what its key, its answers and its inputs look like:
-the generic quiz modules call these methods, so a new type is one module in this package.
+the generic quiz modules call these methods, so a new type is one module in this package
+(plus a template snippet under ``autograder/templates/quiz_types/`` if it has its own form).
 """
 
 from __future__ import annotations
@@ -37,12 +38,17 @@ class LintNote:
 class QuestionType(abc.ABC):
     """One kind of question: its key, its scoring and how it is asked and answered.
 
-    Subclasses set ``name`` and implement the abstract methods; the
+    Subclasses set ``name`` and ``form_template`` and implement the abstract methods; the
     others have defaults that suit questions whose options are listed in the file.
     """
 
     name: ClassVar[str]
     """The ``type:`` a quiz file gives."""
+
+    form_template: ClassVar[str]
+    """A Jinja template with two macros: ``form(q)``, the inputs of a ``QuestionView``
+    named ``q:<question id>...``, and ``reader()``, a JavaScript function of the question's
+    ``<section>`` returning its answer in the answers-file shape (``undefined``: none)."""
 
     has_options: ClassVar[bool] = True
     """Whether the file lists ``options``; a type without them must have none."""

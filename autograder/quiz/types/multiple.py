@@ -28,6 +28,7 @@ from autograder.quiz.views import QuestionView
 @register
 class MultipleChoice(QuestionType):
     name = "multiple"
+    form_template = "quiz_types/multiple.html"
     owned_fields = {"partial_credit": N_("only a multiple question gives partial credit")}
 
     def check_key(self, doc: Document, q: Question, where: Where) -> None:

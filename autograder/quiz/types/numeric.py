@@ -30,6 +30,7 @@ def _is_number(value: Any) -> bool:
 @register
 class Numeric(QuestionType):
     name = "numeric"
+    form_template = "quiz_types/numeric.html"
     has_options = False
     owned_fields = {"tolerance": N_("only a numeric question has a tolerance")}
 

@@ -29,6 +29,7 @@ from autograder.quiz.views import QuestionView
 @register
 class Ordering(QuestionType):
     name = "ordering"
+    form_template = "quiz_types/ordering.html"
 
     def check_option(self, doc: Document, q: Question, option: Option, at: Where) -> None:
         if option.pin:

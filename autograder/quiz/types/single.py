@@ -24,6 +24,7 @@ from autograder.quiz.views import QuestionView
 @register
 class SingleChoice(QuestionType):
     name = "single"
+    form_template = "quiz_types/single.html"
 
     def check_key(self, doc: Document, q: Question, where: Where) -> None:
         ids = q.option_ids
