@@ -279,7 +279,7 @@ def _batch_item(item: str):  # noqa: ANN202
     """How to grade one student's entry for an exercise or a quiz."""
     from autograder.grading.run import grade
     from autograder.quiz.catalog import find_quiz
-    from autograder.quiz.scoring import AnswersError, read_answers, score
+    from autograder.quiz.scoring import read_answers, score
     from autograder.render import formats
 
     try:
@@ -303,7 +303,7 @@ def _batch_item(item: str):  # noqa: ANN202
     def score_one(path: Path):  # noqa: ANN202
         try:
             return score(quiz, read_answers(path, quiz), get_language())
-        except AnswersError:
+        except ContentError:
             return score(quiz, {}, get_language())  # an unreadable answers file scores 0
 
     return score_one, ".json", None

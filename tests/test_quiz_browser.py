@@ -2,16 +2,19 @@
 
 from __future__ import annotations
 
+import json
 import threading
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import pytest
 from browser import chromium_page, ink
 
 from autograder.quiz.catalog import load_all
-from autograder.quiz.model import load_quiz
+from autograder.quiz.model import Question, Quiz, load_quiz
 from autograder.quiz.render import render_page
+from autograder.quiz.scoring import check_answers, key_answers, score
 from autograder.quiz.server import QuizServer
 
 REPO = Path(__file__).resolve().parent.parent
@@ -103,3 +106,45 @@ def test_urdu_page_renders_rtl_in_nastaliq_unclipped(tmp_path: Path) -> None:
     # Not blank, and the title's ink hugs the right side of the page.
     assert stats["ink"] > 20_000
     assert title_ink["right"] > 900 * 0.85 and title_ink["left"] > 900 * 0.2
+
+
+def _enter_key(page: Any, question: Question) -> None:
+    """Fill in the key of one question, as a student would, whatever its inputs."""
+    qid, key = question.id, question.key()
+    if question.type == "numeric":
+        page.fill(f'input[name="q:{qid}"]', str(key))
+    elif question.type == "ordering":
+        for place, item in enumerate(key, 1):
+            page.select_option(f'select[name="q:{qid}:{item}"]', str(place))
+    else:
+        for option in key if isinstance(key, list) else [key]:
+            page.check(f'input[name="q:{qid}"][value="{option}"]')
+
+
+def _comparable(quiz: Quiz, answers: dict[str, Any]) -> dict[str, Any]:
+    """Choose-all answers list ids in page order, the key in file order: sort those."""
+    return {q.id: sorted(answers[q.id]) if q.type == "multiple" else answers[q.id]
+            for q in quiz.questions}
+
+
+def test_saved_answers_file_scores_full_marks_for_every_type(tmp_path: Path) -> None:
+    # Without a server, each question type's reader builds the answers file in the page.
+    with chromium_page() as page:
+        for qf in load_all(REPO):
+            quiz = qf.quiz
+            html = tmp_path / f"{quiz.id}.en.html"
+            html.write_text(render_page(quiz, "en", seed=5), encoding="utf-8")
+            page.goto(html.as_uri())
+            with page.expect_download() as blank:
+                page.click("#save")
+            assert json.loads(Path(blank.value.path()).read_text())["answers"] == {}
+            for question in quiz.questions:
+                _enter_key(page, question)
+            with page.expect_download() as download:
+                page.click("#save")
+            saved = json.loads(Path(download.value.path()).read_text())
+            assert (saved["quiz"], saved["seed"], saved["lang"]) == (quiz.id, "5", "en")
+            assert (_comparable(quiz, saved["answers"])
+                    == _comparable(quiz, key_answers(quiz)["answers"])), quiz.id
+            result = score(quiz, check_answers("answers.json", quiz, saved))
+            assert result.score == result.max_score, quiz.id

@@ -9,10 +9,11 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
+from autograder.core.declarative import ContentError
 from autograder.quiz.catalog import load_all
 from autograder.quiz.cli import quiz_cli
 from autograder.quiz.model import load_quiz
-from autograder.quiz.scoring import AnswersError, key_answers, pass_summary, read_answers, score
+from autograder.quiz.scoring import key_answers, pass_summary, read_answers, score
 
 REPO = Path(__file__).resolve().parent.parent
 PART2 = REPO / "quizzes" / "part2-rclpy.yaml"
@@ -150,7 +151,7 @@ BAD_ANSWERS = [
 def test_bad_answers_file(tmp_path: Path, text: str, message: str) -> None:
     path = _write(tmp_path, text)
     quiz = load_quiz(PART2).quiz
-    with pytest.raises(AnswersError) as info:
+    with pytest.raises(ContentError) as info:
         read_answers(path, quiz)
     assert message in str(info.value) and str(path.name) in str(info.value)
     results = tmp_path / "results.json"

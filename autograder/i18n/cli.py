@@ -13,8 +13,9 @@ import click
 
 from autograder.commands.exits import ProblemsFound, UsageProblem
 from autograder.core.course import course_root
+from autograder.core.declarative import ContentError
 from autograder.i18n import LANGUAGES, _, locales_dir, ngettext
-from autograder.i18n.tools import CatalogError, check_catalog, compile_catalogs, extract, update
+from autograder.i18n.tools import check_catalog, compile_catalogs, extract, update
 
 _TARGETS = tuple(lang for lang in LANGUAGES if lang != "en")
 
@@ -37,7 +38,7 @@ def extract_command() -> None:
     try:
         for path in extract(course_root(), locales_dir()):
             click.echo(_("wrote {path}").format(path=_relative(path)))
-    except CatalogError as exc:
+    except ContentError as exc:
         raise UsageProblem(str(exc)) from None
 
 
@@ -49,7 +50,7 @@ def update_command(langs: tuple[str, ...]) -> None:
     try:
         for path in update(locales_dir(), langs):
             click.echo(_("updated {path}").format(path=_relative(path)))
-    except CatalogError as exc:
+    except ContentError as exc:
         raise UsageProblem(str(exc)) from None
 
 
@@ -59,7 +60,7 @@ def compile_command() -> None:
     try:
         for path in compile_catalogs(locales_dir()):
             click.echo(_("compiled {path}").format(path=_relative(path)))
-    except CatalogError as exc:
+    except ContentError as exc:
         raise UsageProblem(str(exc)) from None
 
 

@@ -34,8 +34,6 @@ _PLACEHOLDER = re.compile(r"\{[A-Za-z_][\w]*(?:![rsa])?(?::[^{}]*)?\}|%\(\w+\)[s
 _CODE = re.compile(r"`[^`]+`")
 
 
-# A malformed catalog or mapping file is the one path:line content error.
-CatalogError = ContentError
 
 
 @dataclasses.dataclass(frozen=True)
@@ -55,9 +53,9 @@ def read_mapping(cfg: Path) -> tuple[list[tuple[str, str]], dict[str, dict[str, 
         with cfg.open(encoding="utf-8") as fh:
             return parse_mapping_cfg(fh, str(cfg))
     except FileNotFoundError:
-        raise CatalogError(cfg, _("file not found")) from None
+        raise ContentError(cfg, _("file not found")) from None
     except Exception as exc:  # configparser raises several kinds
-        raise CatalogError(cfg, _("cannot read the mapping: {error}").format(
+        raise ContentError(cfg, _("cannot read the mapping: {error}").format(
             error=str(exc).splitlines()[0])) from None
 
 
@@ -78,7 +76,7 @@ def _collect(root: Path, method_map: list[tuple[str, str]],
                         context=context)
     except Exception as exc:
         # A quiz or exercise file that does not load names itself; other errors too.
-        raise CatalogError(root, _("extraction failed: {error}").format(error=exc)) from None
+        raise ContentError(root, _("extraction failed: {error}").format(error=exc)) from None
     return catalog
 
 
@@ -102,13 +100,13 @@ def read_catalog(path: Path, locale: str | None = None) -> Catalog:
         with path.open("rb") as fh:
             return read_po(fh, locale=locale, abort_invalid=True)
     except FileNotFoundError:
-        raise CatalogError(path, _("file not found")) from None
+        raise ContentError(path, _("file not found")) from None
     except PoFileError as exc:
         message = str(exc).rsplit(" on ", 1)[0]
-        raise CatalogError(path, _("malformed catalog: {problem}").format(problem=message),
+        raise ContentError(path, _("malformed catalog: {problem}").format(problem=message),
                            exc.lineno) from None
     except (ValueError, UnicodeDecodeError) as exc:
-        raise CatalogError(path, _("malformed catalog: {problem}").format(problem=exc)) from None
+        raise ContentError(path, _("malformed catalog: {problem}").format(problem=exc)) from None
 
 
 def _write(path: Path, catalog: Catalog) -> None:
@@ -190,7 +188,7 @@ def check_catalog(template_path: Path, po: Path, lang: str) -> list[Problem]:
     try:
         template = read_catalog(template_path)
         catalog = read_catalog(po, lang)
-    except CatalogError as exc:
+    except ContentError as exc:
         return [Problem(exc.path, exc.line, exc.message)]
     problems = []
     for entry in template:

@@ -1,7 +1,7 @@
 """``autograder quiz``: list, lint, render, take, score, key and serve quizzes.
 
 A thin click layer: each command calls plain functions of the quiz package, and every
-bad input becomes one line naming the file (see ``autograder.quiz.errors``).
+bad input becomes one line naming the file (see ``autograder.commands.exits``).
 """
 
 from __future__ import annotations
@@ -14,6 +14,7 @@ from typing import Any, TypeVar
 
 import click
 
+from autograder.commands.exits import ProblemsFound, UsageProblem
 from autograder.core.declarative import ContentError
 from autograder.core.results import RunResult
 from autograder.i18n import (
@@ -25,36 +26,29 @@ from autograder.i18n import (
     ngettext,
     set_language,
 )
-from autograder.i18n.tools import CatalogError, read_catalog
+from autograder.i18n.tools import read_catalog
 from autograder.quiz import CONTENT_DOMAIN
 from autograder.quiz.catalog import find_quiz, list_quizzes, load_all
-from autograder.quiz.errors import AnswersFileError, ContentFileError, LintFailed, ServeError
 from autograder.quiz.localize import Localizer, format_number, format_percent, terminal
 from autograder.quiz.model import Quiz
-from autograder.quiz.render import question_views, render_markdown, render_page
-from autograder.quiz.scoring import (
-    AnswersError,
-    key_answers,
-    pass_summary,
-    read_answers,
-    result_dict,
-    score,
-)
+from autograder.quiz.render import render_markdown, render_page
+from autograder.quiz.scoring import key_answers, pass_summary, read_answers, result_dict, score
+from autograder.quiz.types import question_type
+from autograder.quiz.types.base import QuestionType
+from autograder.quiz.views import QuestionView, question_views
 
 F = TypeVar("F", bound=Callable[..., Any])
 
 
 def _errors(func: F) -> F:
-    """Turn our error types into one-line ClickExceptions."""
+    """Turn a bad quiz, answers or catalog file into a one-line ClickException."""
 
     @functools.wraps(func)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
         try:
             return func(*args, **kwargs)
-        except (ContentError, CatalogError) as exc:
-            raise ContentFileError(str(exc)) from None
-        except AnswersError as exc:
-            raise AnswersFileError(str(exc)) from None
+        except ContentError as exc:
+            raise UsageProblem(str(exc)) from None
 
     return wrapper  # type: ignore[return-value]
 
@@ -108,7 +102,7 @@ def lint_command() -> None:
     for p in problems:
         click.echo(str(p), err=True)
     if problems:
-        raise LintFailed(ngettext("{count} problem found", "{count} problems found",
+        raise ProblemsFound(ngettext("{count} problem found", "{count} problems found",
                                   len(problems)).format(count=len(problems)))
     click.echo(_("All quizzes are complete and translated."))
 
@@ -188,39 +182,14 @@ def key_command(quiz: str) -> None:
     click.echo(json.dumps(key_answers(find_quiz(quiz).quiz), ensure_ascii=False, indent=2))
 
 
-def _ask(q: Any, lang: str) -> Any:
+def _ask(kind: QuestionType, view: QuestionView) -> Any:
     """Prompt until the answer parses; Enter skips the question."""
-    n = len(q.options)
     while True:
-        if q.type == "numeric":
-            raw = click.prompt(_("Your answer (a number, Enter to skip)"), default="",
-                               show_default=False)
-        elif q.type == "multiple":
-            raw = click.prompt(_("Your answers (numbers separated by commas, Enter to skip)"),
-                               default="", show_default=False)
-        elif q.type == "ordering":
-            raw = click.prompt(_("The order (numbers separated by spaces, first one first)"),
-                               default="", show_default=False)
-        else:
-            raw = click.prompt(_("Your answer (1 to {count}, Enter to skip)").format(count=n),
-                               default="", show_default=False)
-        raw = raw.strip()
+        raw = click.prompt(kind.prompt(view), default="", show_default=False).strip()
         if not raw:
             return None
         try:
-            if q.type == "numeric":
-                return float(raw)
-            picks = [int(x) for x in raw.replace(",", " ").split()]
-            if not picks or any(not 1 <= p <= n for p in picks) or len(set(picks)) != len(picks):
-                raise ValueError(raw)
-            ids = [q.options[p - 1].id for p in picks]
-            if q.type in ("single", "true_false"):
-                if len(ids) != 1:
-                    raise ValueError(raw)
-                return ids[0]
-            if q.type == "ordering" and len(ids) != n:
-                raise ValueError(raw)
-            return ids
+            return kind.parse_terminal(view, raw)
         except ValueError:
             click.echo(_("That is not an answer to this question; try again."), err=True)
 
@@ -251,13 +220,10 @@ def take_command(quiz: str, lang: str | None, seed: str | None, save: Path | Non
         click.echo(f"{view.number}. {terminal(view.text)}")
         if view.code:
             click.echo("\n".join("    " + line for line in view.code.splitlines()))
-        if view.type == "multiple":
-            click.echo(_("Choose all that apply."))
-        for i, o in enumerate(view.options, 1):
-            click.echo(f"  {i}) {terminal(o.text)}")
-        if view.unit:
-            click.echo(f"  [{terminal(view.unit)}]")
-        value = _ask(view, lang)
+        kind = question_type(view.type)
+        for line in kind.terminal_lines(view):
+            click.echo(line)
+        value = _ask(kind, view)
         if value is not None:
             answers[view.id] = value
     result = score(qf.quiz, answers, lang)
@@ -284,7 +250,7 @@ def serve_command(port: int, lang: str | None) -> None:
     try:
         server = QuizServer(files, port, lang)
     except OSError as exc:
-        raise ServeError(_("cannot listen on 127.0.0.1:{port}: {error}").format(
+        raise UsageProblem(_("cannot listen on 127.0.0.1:{port}: {error}").format(
             port=port, error=exc.strerror or exc)) from None
     click.echo(_("Quizzes at {url} (Ctrl-C stops the server)").format(url=server.url))
     try:

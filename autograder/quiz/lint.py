@@ -1,8 +1,8 @@
 """``autograder quiz lint``: every problem an instructor must fix before a release.
 
-Quiz files load (ids unique, keys valid), numeric tolerances are sane, and every string
-is translated, not fuzzy, with its placeholders and code unchanged, in every language the
-quiz is offered in.
+Quiz files load (ids unique, keys valid), settings a question's type doubts are reported
+(a numeric tolerance that also accepts 0), and every string is translated, not fuzzy, with
+its placeholders and code unchanged, in every language the quiz is offered in.
 """
 
 from __future__ import annotations
@@ -10,11 +10,12 @@ from __future__ import annotations
 from pathlib import Path
 
 from autograder.core.declarative import ContentError
-from autograder.i18n import _, locales_dir
-from autograder.i18n.tools import CatalogError, Problem, check_message, read_catalog
+from autograder.i18n import locales_dir
+from autograder.i18n.tools import Problem, check_message, read_catalog
 from autograder.quiz import CONTENT_DOMAIN
 from autograder.quiz.catalog import quiz_paths
 from autograder.quiz.model import QuizFile, check_ids_unique, load_quiz, strings
+from autograder.quiz.types import question_type
 
 
 def _problem(exc: ContentError) -> Problem:
@@ -22,14 +23,11 @@ def _problem(exc: ContentError) -> Problem:
     return Problem(exc.path, exc.line, message)
 
 
-def _tolerances(qf: QuizFile) -> list[Problem]:
-    problems = []
-    for i, q in enumerate(qf.quiz.questions):
-        if q.type == "numeric" and q.answer and q.tolerance >= abs(q.answer):
-            problems.append(Problem(qf.path, qf.line("questions", i, "tolerance"), _(
-                "questions.{index}.tolerance: a tolerance of {tolerance} around {answer} "
-                "also accepts 0").format(index=i, tolerance=q.tolerance, answer=q.answer)))
-    return problems
+def _type_notes(qf: QuizFile) -> list[Problem]:
+    """What each question's type finds doubtful in a question that loads."""
+    return [Problem(qf.path, qf.line("questions", i, note.field), note.message)
+            for i, q in enumerate(qf.quiz.questions)
+            for note in question_type(q.type).lint_notes(q, i)]
 
 
 def lint(root: Path | None = None, locales: Path | None = None) -> list[Problem]:
@@ -45,7 +43,7 @@ def lint(root: Path | None = None, locales: Path | None = None) -> list[Problem]
     problems += [_problem(e) for e in check_ids_unique(files)]
     catalogs: dict[str, object] = {}
     for qf in files:
-        problems += _tolerances(qf)
+        problems += _type_notes(qf)
         for lang in qf.quiz.languages:
             if lang == "en":
                 continue
@@ -53,7 +51,7 @@ def lint(root: Path | None = None, locales: Path | None = None) -> list[Problem]
             if lang not in catalogs:
                 try:
                     catalogs[lang] = read_catalog(po, lang)
-                except CatalogError as exc:
+                except ContentError as exc:
                     catalogs[lang] = None
                     problems.append(Problem(exc.path, exc.line, exc.message))
             catalog = catalogs[lang]

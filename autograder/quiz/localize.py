@@ -151,3 +151,25 @@ def terminal(text: Text) -> str:
     """Text for a terminal: paragraphs on one line each (wrapping breaks bidi), code kept
     in backticks so it stands out."""
     return _paragraphs(text.value)
+
+
+_MDX_ESCAPES = {"{": "\\{", "}": "\\}", "<": "&lt;", ">": "&gt;", "*": "\\*", "#": "\\#"}
+
+
+def markdown_inline(text: Text) -> str:
+    """Markdown/MDX for a string: code spans kept; in RTL text, code and Latin runs wrapped
+    in Unicode isolates (markup cannot go inside every Markdown construct)."""
+    rtl = is_rtl(text.lang) and not text.fallback
+    out = []
+    value = " ".join(text.value.split())
+    for i, piece in enumerate(CODE_SPAN.split(value)):
+        if i % 2:
+            out.append(f"{LRI}`{piece}`{PDI}" if rtl else f"`{piece}`")
+            continue
+        escaped = "".join(_MDX_ESCAPES.get(c, c) for c in piece)
+        out.append(LATIN_RUN.sub(lambda m: f"{LRI}{m.group(0)}{PDI}", escaped) if rtl
+                   else escaped)
+    md = "".join(out)
+    if text.fallback:
+        return f'<span lang="en" dir="ltr">{md}</span>'
+    return md

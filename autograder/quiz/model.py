@@ -2,26 +2,25 @@
 
 The answer key names option ids, never positions or text, so shuffling and translation
 cannot break it.  A malformed file is a :class:`~autograder.core.declarative.ContentError`
-naming the file, the line and the field.
+naming the file, the line and the field.  What a key and options must look like is up to
+the question's type (``autograder.quiz.types``); the checks here hold for every type.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import math
 import re
 from collections.abc import Iterator
 from fractions import Fraction
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any
 
 from autograder.core.declarative import ContentError, Document, build, load_document
 from autograder.core.results import exact
 from autograder.i18n import _
+from autograder.quiz.types import question_type, registry
 
-QuestionType = Literal["single", "multiple", "true_false", "numeric", "ordering"]
 ID_PATTERN = re.compile(r"^[a-z0-9][a-z0-9_-]*$")
-TRUE_FALSE_IDS = ("true", "false")
 
 
 def _doc(text: str) -> dict[str, str]:
@@ -45,8 +44,9 @@ class Question:
     """One question; ``answer`` is the key and never reaches a student."""
 
     id: str = dataclasses.field(default="", metadata=_doc("Stable id, unique in the quiz."))
-    type: QuestionType = dataclasses.field(default="single", metadata=_doc(
-        "single, multiple, true_false, numeric or ordering."))
+    type: str = dataclasses.field(default="single", metadata=_doc(
+        "A question type of autograder.quiz.types: single, multiple, true_false, numeric "
+        "or ordering as shipped."))
     text: str = dataclasses.field(default="", metadata=_doc(
         "The question; `backticks` mark inline code."))
     code: str = dataclasses.field(default="", metadata=_doc(
@@ -67,17 +67,12 @@ class Question:
 
     @property
     def option_ids(self) -> tuple[str, ...]:
-        if self.type == "true_false":
-            return TRUE_FALSE_IDS
-        return tuple(o.id for o in self.options)
+        """The ids an answer may name (for true_false: ``true`` and ``false``)."""
+        return question_type(self.type).option_ids(self)
 
     def key(self) -> Any:
         """The key as an answers file states it (option ids, never booleans)."""
-        if self.type == "true_false":
-            return "true" if self.answer else "false"
-        if isinstance(self.answer, tuple):
-            return list(self.answer)
-        return self.answer
+        return question_type(self.type).key(self)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -167,7 +162,8 @@ def load_quiz(path: Path | str, text: str | None = None) -> QuizFile:
     return QuizFile(Path(path), quiz, doc)
 
 
-def _check_id(doc: Document, value: str, *where: str | int) -> None:
+def check_id(doc: Document, value: str, *where: str | int) -> None:
+    """Ids (of quizzes, questions, options) are lower-case words, safe in URLs and forms."""
     if not ID_PATTERN.match(value):
         raise doc.error(_("id {id!r} must be lower-case letters, digits, '-' or '_'").format(
             id=value), *where)
@@ -175,7 +171,13 @@ def _check_id(doc: Document, value: str, *where: str | int) -> None:
 
 def _check(doc: Document, quiz: Quiz) -> None:
     """Checks no dataclass type can state: ids unique, keys valid, numbers sane."""
-    _check_id(doc, quiz.id, "id")
+    types = registry()
+    for i, q in enumerate(quiz.questions):  # first: every later check goes through the type
+        if q.type not in types:
+            raise doc.error(_("must be one of {allowed}, found {value!r}").format(
+                allowed=", ".join(repr(name) for name in sorted(types)), value=q.type),
+                "questions", i, "type")
+    check_id(doc, quiz.id, "id")
     if not quiz.title.strip():
         raise doc.error(_("required field is missing"), "title")
     if not 0 < quiz.pass_mark <= 1:
@@ -188,7 +190,7 @@ def _check(doc: Document, quiz: Quiz) -> None:
         where = ("questions", i)
         if not q.id:
             raise doc.error(_("required field is missing"), *where, "id")
-        _check_id(doc, q.id, *where, "id")
+        check_id(doc, q.id, *where, "id")
         if q.id in seen:
             raise doc.error(_("duplicate question id {id!r}").format(id=q.id), *where, "id")
         seen.add(q.id)
@@ -197,75 +199,15 @@ def _check(doc: Document, quiz: Quiz) -> None:
         if q.points < 1:
             raise doc.error(_("must be at least 1, found {value!r}").format(value=q.points),
                             *where, "points")
-        _check_options(doc, q, where)
-        _check_key(doc, q, where)
-
-
-def _check_options(doc: Document, q: Question, where: tuple[str | int, ...]) -> None:
-    if q.type in ("true_false", "numeric"):
-        if q.options:
-            raise doc.error(_("a {type} question has no options").format(type=q.type),
-                            *where, "options")
-        return
-    if len(q.options) < 2:
-        raise doc.error(_("needs at least 2 options, found {count}").format(
-            count=len(q.options)), *where, "options")
-    ids: set[str] = set()
-    for j, o in enumerate(q.options):
-        if not o.id:
-            raise doc.error(_("required field is missing"), *where, "options", j, "id")
-        _check_id(doc, o.id, *where, "options", j, "id")
-        if o.id in ids:
-            raise doc.error(_("duplicate option id {id!r}").format(id=o.id),
-                            *where, "options", j, "id")
-        ids.add(o.id)
-        if not o.text.strip():
-            raise doc.error(_("required field is missing"), *where, "options", j, "text")
-        if o.pin and q.type == "ordering":
-            raise doc.error(_("items of an ordering question cannot be pinned"),
-                            *where, "options", j, "pin")
-
-
-def _check_key(doc: Document, q: Question, where: tuple[str | int, ...]) -> None:
-    at = (*where, "answer")
-    a = q.answer
-    if a is None:
-        raise doc.error(_("every question needs an answer key"), *at)
-    ids = q.option_ids
-    if q.type == "single":
-        if not isinstance(a, str) or a not in ids:
-            raise doc.error(_("the key must be one option id ({ids}), found {value!r}").format(
-                ids=", ".join(ids), value=a), *at)
-    elif q.type == "true_false":
-        if not isinstance(a, bool):
-            raise doc.error(_("the key must be true or false, found {value!r}").format(value=a),
-                            *at)
-    elif q.type == "numeric":
-        if isinstance(a, bool) or not isinstance(a, (int, float)) or not math.isfinite(a):
-            raise doc.error(_("the key must be a number, found {value!r}").format(value=a), *at)
-        if not math.isfinite(q.tolerance) or q.tolerance < 0:
-            raise doc.error(_("the tolerance must be a finite number, 0 or more, "
-                              "found {value!r}").format(value=q.tolerance), *where, "tolerance")
-    else:
-        if not isinstance(a, list) or not all(isinstance(x, str) for x in a):
-            raise doc.error(_("the key must be a list of option ids, found {value!r}").format(
-                value=a), *at)
-        unknown = [x for x in a if x not in ids]
-        if unknown:
-            raise doc.error(_("the key names no option {id!r} (options: {ids})").format(
-                id=unknown[0], ids=", ".join(ids)), *at)
-        if len(set(a)) != len(a):
-            raise doc.error(_("the key names an option twice"), *at)
-        if q.type == "multiple" and not a:
-            raise doc.error(_("the key must name at least one option"), *at)
-        if q.type == "ordering" and len(a) != len(ids):
-            raise doc.error(_("the key must put every item in order ({ids})").format(
-                ids=", ".join(ids)), *at)
-    if q.type != "numeric" and q.tolerance:
-        raise doc.error(_("only a numeric question has a tolerance"), *where, "tolerance")
-    if q.type != "multiple" and q.partial_credit:
-        raise doc.error(_("only a multiple question gives partial credit"),
-                        *where, "partial_credit")
+        kind = types[q.type]
+        kind.check_options(doc, q, where)
+        if q.answer is None:
+            raise doc.error(_("every question needs an answer key"), *where, "answer")
+        kind.check_key(doc, q, where)
+        for other in types.values():  # a field only other types use, set here by mistake
+            for name, message in other.owned_fields.items():
+                if name not in kind.owned_fields and getattr(q, name):
+                    raise doc.error(_(message), *where, name)
 
 
 def check_ids_unique(files: list[QuizFile]) -> list[ContentError]:

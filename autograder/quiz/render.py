@@ -1,12 +1,12 @@
 """What a student receives: an HTML page, a Markdown/MDX export, terminal text.
 
 Everything here is built from *views* that carry no answer key (``question_views``), so
-no renderer can leak it.  HTML comes from autoescaped Jinja2 templates.
+no renderer can leak it.  HTML comes from autoescaped Jinja2 templates; what is particular
+to a question type (its inputs, its Markdown) comes from the type.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import json
 from collections.abc import Mapping
 from typing import Any
@@ -17,59 +17,22 @@ from markupsafe import Markup
 from autograder.core.results import RunResult
 from autograder.i18n import _, is_rtl, ngettext
 from autograder.quiz.localize import (
-    CODE_SPAN,
-    LATIN_RUN,
-    LRI,
-    PDI,
     Localizer,
     Text,
     format_number,
     format_percent,
+    markdown_inline,
     plain,
     rich,
     using_language,
 )
 from autograder.quiz.model import Quiz
 from autograder.quiz.scoring import pass_summary
-from autograder.quiz.shuffle import option_order
+from autograder.quiz.types import question_type
+from autograder.quiz.views import question_views
 
 FONT_STACK_UR = ('"Noto Nastaliq Urdu", "Jameel Noori Nastaleeq", "Urdu Typesetting", '
                  '"Noto Naskh Arabic", serif')
-
-
-@dataclasses.dataclass(frozen=True)
-class OptionView:
-    id: str
-    text: Text
-
-
-@dataclasses.dataclass(frozen=True)
-class QuestionView:
-    """A question as a student sees it: no key, options in this attempt's order."""
-
-    number: int
-    id: str
-    type: str
-    text: Text
-    code: str
-    unit: Text | None
-    points: int
-    options: tuple[OptionView, ...]
-
-
-def question_views(quiz: Quiz, lang: str, seed: str | int | None) -> list[QuestionView]:
-    loc = Localizer(quiz, lang)
-    views = []
-    for n, q in enumerate(quiz.questions, 1):
-        if q.type == "true_false":
-            options = (OptionView("true", Text(_("True"), lang)),
-                       OptionView("false", Text(_("False"), lang)))
-        else:
-            options = tuple(OptionView(o.id, loc.option(q, o))
-                            for o in option_order(quiz, q, seed))
-        views.append(QuestionView(n, q.id, q.type, loc.text(q, "text"), q.code.rstrip(),
-                                  loc.text(q, "unit") if q.unit else None, q.points, options))
-    return views
 
 
 def _environment() -> jinja2.Environment:
@@ -151,27 +114,6 @@ def render_index(quizzes: list[Quiz], lang: str, languages: tuple[str, ...]) -> 
 
 # Markdown / MDX ---------------------------------------------------------------------------
 
-_MDX_ESCAPES = {"{": "\\{", "}": "\\}", "<": "&lt;", ">": "&gt;", "*": "\\*", "#": "\\#"}
-
-
-def _md_inline(text: Text) -> str:
-    """Markdown for a string: code spans kept; in RTL text, code and Latin runs wrapped in
-    Unicode isolates (markup cannot go inside every Markdown construct)."""
-    rtl = is_rtl(text.lang) and not text.fallback
-    out = []
-    value = " ".join(text.value.split())
-    for i, piece in enumerate(CODE_SPAN.split(value)):
-        if i % 2:
-            out.append(f"{LRI}`{piece}`{PDI}" if rtl else f"`{piece}`")
-            continue
-        escaped = "".join(_MDX_ESCAPES.get(c, c) for c in piece)
-        out.append(LATIN_RUN.sub(lambda m: f"{LRI}{m.group(0)}{PDI}", escaped) if rtl
-                   else escaped)
-    md = "".join(out)
-    if text.fallback:
-        return f'<span lang="en" dir="ltr">{md}</span>'
-    return md
-
 
 def render_markdown(quiz: Quiz, lang: str, seed: str | int | None = None) -> str:
     """A Markdown/MDX export for a Docusaurus page: questions and options, never the key."""
@@ -182,27 +124,17 @@ def render_markdown(quiz: Quiz, lang: str, seed: str | int | None = None) -> str
                  "---", ""]
         if rtl:
             lines += [f'<div dir="rtl" lang="{lang}">', ""]
-        lines += [f"# {_md_inline(ctx['title'])}", ""]
+        lines += [f"# {markdown_inline(ctx['title'])}", ""]
         if ctx["summary"]:
-            lines += [_md_inline(ctx["summary"]), ""]
-        lines += [f"**{_md_inline(Text(ctx['pass_summary'], lang))}**", ""]
+            lines += [markdown_inline(ctx["summary"]), ""]
+        lines += [f"**{markdown_inline(Text(ctx['pass_summary'], lang))}**", ""]
         for q in question_views(quiz, lang, seed):
-            lines += [f"## {format_number(q.number, lang)}. {_md_inline(q.text)}", ""]
+            lines += [f"## {format_number(q.number, lang)}. {markdown_inline(q.text)}", ""]
             if q.code:
                 block = ["```python", q.code, "```"]
                 lines += (['<div dir="ltr">', "", *block, "", "</div>"] if rtl else block)
                 lines.append("")
-            if q.type == "numeric":
-                unit = f" {_md_inline(q.unit)}" if q.unit else ""
-                lines += [f"{_('Answer:')} \\_\\_\\_\\_\\_\\_{unit}", ""]
-            elif q.type == "ordering":
-                lines += [_("Put these in order:"), ""]
-                lines += [f"- [ ] {_md_inline(o.text)}" for o in q.options] + [""]
-            else:
-                mark = "☐" if q.type == "multiple" else "○"
-                if q.type == "multiple":
-                    lines += [_("Choose all that apply."), ""]
-                lines += [f"- {mark} {_md_inline(o.text)}" for o in q.options] + [""]
+            lines += question_type(q.type).markdown_lines(q)
         if rtl:
             lines += ["</div>", ""]
         return "\n".join(lines)

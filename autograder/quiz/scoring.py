@@ -1,4 +1,8 @@
-"""Score an answers file against a quiz, exactly, into the one results model."""
+"""Score an answers file against a quiz, exactly, into the one results model.
+
+A bad answers file is a :class:`~autograder.core.declarative.ContentError` naming the file
+and the line, as a bad quiz file is; each question's type checks and scores its answer.
+"""
 
 from __future__ import annotations
 
@@ -10,24 +14,14 @@ from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
-from autograder.core.results import RunResult, TestResult, exact
+from autograder.core.declarative import ContentError
+from autograder.core.results import RunResult, TestResult
 from autograder.i18n import _, ngettext
 from autograder.quiz.localize import Localizer, format_number, format_percent, using_language
-from autograder.quiz.model import Question, Quiz
+from autograder.quiz.model import Quiz
+from autograder.quiz.types import question_type
 
 ANSWERS_KEYS = {"quiz", "answers", "seed", "lang", "student"}
-
-
-class AnswersError(Exception):
-    """An answers file that cannot be scored: bad JSON, wrong quiz, unknown id."""
-
-    def __init__(self, path: Path | str, message: str, line: int | None = None) -> None:
-        self.path, self.message, self.line = Path(path), message, line
-        super().__init__(str(self))
-
-    def __str__(self) -> str:
-        where = f"{self.path}:{self.line}" if self.line else str(self.path)
-        return f"{where}: {self.message}"
 
 
 def _line_of(text: str, key: str) -> int | None:
@@ -42,13 +36,13 @@ def read_answers(path: Path | str, quiz: Quiz, text: str | None = None) -> dict[
     try:
         text = path.read_text(encoding="utf-8") if text is None else text
     except FileNotFoundError:
-        raise AnswersError(path, _("file not found")) from None
+        raise ContentError(path, _("file not found")) from None
     except (OSError, UnicodeDecodeError) as exc:
-        raise AnswersError(path, _("cannot read file: {error}").format(error=exc)) from None
+        raise ContentError(path, _("cannot read file: {error}").format(error=exc)) from None
     try:
         data = json.loads(text)
     except json.JSONDecodeError as exc:
-        raise AnswersError(path, _("not valid JSON: {problem} (column {column})").format(
+        raise ContentError(path, _("not valid JSON: {problem} (column {column})").format(
             problem=exc.msg, column=exc.colno), exc.lineno) from None
     return check_answers(path, quiz, data, text)
 
@@ -56,68 +50,25 @@ def read_answers(path: Path | str, quiz: Quiz, text: str | None = None) -> dict[
 def check_answers(path: Path | str, quiz: Quiz, data: Any, text: str = "") -> dict[str, Any]:
     """Check the shape of decoded answers; the error names the file, line and id."""
     if not isinstance(data, dict) or not isinstance(data.get("answers"), dict):
-        raise AnswersError(path, _('must be a JSON object {{"quiz": ..., "answers": {{...}}}}'))
+        raise ContentError(path, _('must be a JSON object {{"quiz": ..., "answers": {{...}}}}'))
     unknown = sorted(set(data) - ANSWERS_KEYS)
     if unknown:
-        raise AnswersError(path, _("unknown key {key!r} (expected: {known})").format(
+        raise ContentError(path, _("unknown key {key!r} (expected: {known})").format(
             key=unknown[0], known=", ".join(sorted(ANSWERS_KEYS))), _line_of(text, unknown[0]))
     if data.get("quiz") != quiz.id:
-        raise AnswersError(path, _("answers quiz {found!r}, not {expected!r}").format(
+        raise ContentError(path, _("answers quiz {found!r}, not {expected!r}").format(
             found=data.get("quiz"), expected=quiz.id), _line_of(text, "quiz"))
     answers: dict[str, Any] = data["answers"]
     for qid, value in answers.items():
         q = quiz.question(qid)
         line = _line_of(text, qid)
         if q is None:
-            raise AnswersError(path, _("no question {id!r} in quiz {quiz!r}").format(
+            raise ContentError(path, _("no question {id!r} in quiz {quiz!r}").format(
                 id=qid, quiz=quiz.id), line)
-        _check_value(path, q, value, line)
+        problem = question_type(q.type).answer_problem(q, value)
+        if problem:
+            raise ContentError(path, problem, line)
     return answers
-
-
-def _check_value(path: Path | str, q: Question, value: Any, line: int | None) -> None:
-    if q.type == "true_false" and isinstance(value, bool):
-        return
-    if q.type == "numeric":
-        if isinstance(value, bool) or not isinstance(value, (int, float)) \
-                or not math.isfinite(value):
-            raise AnswersError(path, _("question {id!r} needs a number, found {value!r}").format(
-                id=q.id, value=value), line)
-        return
-    chosen = value if isinstance(value, list) and q.type in ("multiple", "ordering") else [value]
-    if q.type in ("single", "true_false") and not isinstance(value, str):
-        raise AnswersError(path, _("question {id!r} needs one option id, found {value!r}").format(
-            id=q.id, value=value), line)
-    if q.type in ("multiple", "ordering") and not isinstance(value, list):
-        raise AnswersError(path, _("question {id!r} needs a list of option ids, found {value!r}")
-                           .format(id=q.id, value=value), line)
-    for option in chosen:
-        if option not in q.option_ids:
-            raise AnswersError(path, _("question {id!r} has no option {option!r} "
-                                       "(options: {ids})").format(
-                id=q.id, option=option, ids=", ".join(q.option_ids)), line)
-    if len(set(chosen)) != len(chosen):
-        raise AnswersError(path, _("question {id!r} names an option twice").format(id=q.id), line)
-
-
-def _credit(q: Question, value: Any) -> Fraction:
-    """The fraction of the question's points an answer earns (0 to 1), exactly."""
-    if value is None:
-        return Fraction(0)
-    if q.type == "single":
-        return Fraction(value == q.answer)
-    if q.type == "true_false":
-        chosen = value if isinstance(value, bool) else value == "true"
-        return Fraction(chosen == q.answer)
-    if q.type == "numeric":
-        return Fraction(abs(exact(value) - exact(q.answer)) <= exact(q.tolerance))
-    if q.type == "ordering":
-        return Fraction(list(value) == list(q.answer))
-    right, chosen = set(q.answer), set(value)
-    if not q.partial_credit:
-        return Fraction(chosen == right)
-    earned = len(chosen & right) - len(chosen - right)
-    return max(Fraction(0), Fraction(earned, len(right)))
 
 
 def needed_to_pass(quiz: Quiz) -> int:
@@ -154,20 +105,13 @@ def _score(quiz: Quiz, answers: Mapping[str, Any], lang: str) -> RunResult:
     tests = []
     for q in quiz.questions:
         value = answers.get(q.id)
+        kind = question_type(q.type)
         points = Fraction(q.points)
-        earned = _credit(q, value) * points
-        if value is None:
-            message = _("Not answered.")
-        elif earned == points:
-            message = _("Correct.")
-        elif earned:
-            message = _("Partly correct: {score} of {max} points.").format(
-                score=format_number(earned, lang), max=format_number(points, lang))
-        else:
-            message = _("Incorrect.")
+        earned = Fraction(0) if value is None else kind.credit(q, value) * points
         tests.append(TestResult(
             name=q.id, label=loc.text(q, "text").value, score=earned, max_score=points,
-            status="passed" if earned == points else "failed", message=message,
+            status="passed" if earned == points else "failed",
+            message=kind.feedback(q, value, earned, lang),
             hint=loc.text(q, "explanation").value if q.explanation else "",
             data={"answer": value}))
     return RunResult(kind="quiz", id=quiz.id, title=loc.quiz_text("title").value,

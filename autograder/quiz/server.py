@@ -16,41 +16,24 @@ from urllib.parse import parse_qs, urlsplit
 
 from markupsafe import escape
 
+from autograder.core.declarative import ContentError
 from autograder.i18n import LANGUAGES, _
 from autograder.quiz.localize import using_language
 from autograder.quiz.model import Quiz, QuizFile
 from autograder.quiz.render import render_index, render_page, render_result
-from autograder.quiz.scoring import AnswersError, check_answers, score
+from autograder.quiz.scoring import check_answers, score
+from autograder.quiz.types import question_type
 
 HOST = "127.0.0.1"
-_DIGITS = str.maketrans("۰۱۲۳۴۵۶۷۸۹٠١٢٣٤٥٦٧٨٩٫", "01234567890123456789.")
 
 
 def form_answers(quiz: Quiz, form: Mapping[str, list[str]]) -> dict[str, Any]:
     """Answers from a submitted form, in the answers-file shape; blanks are left out."""
     answers: dict[str, Any] = {}
     for q in quiz.questions:
-        values = [v for v in form.get(f"q:{q.id}", []) if v]
-        if q.type == "multiple":
-            if values:
-                answers[q.id] = values
-        elif q.type == "numeric":
-            try:
-                answers[q.id] = float(values[0].strip().translate(_DIGITS)) if values else None
-            except ValueError:
-                answers[q.id] = None
-            if answers[q.id] is None:
-                del answers[q.id]
-        elif q.type == "ordering":
-            places = []
-            for i, o in enumerate(q.options):
-                place = form.get(f"q:{q.id}:{o.id}", [""])[0]
-                if place.isdigit():
-                    places.append((int(place), i, o.id))
-            if len(places) == len(q.options):
-                answers[q.id] = [oid for _p, _i, oid in sorted(places)]
-        elif values:
-            answers[q.id] = values[0]
+        value = question_type(q.type).parse_form(q, form)
+        if value is not None:
+            answers[q.id] = value
     return answers
 
 
@@ -134,7 +117,7 @@ class _Handler(BaseHTTPRequestHandler):
                                                          "answers": form_answers(quiz, form)})
                 result = score(quiz, answers, lang)
                 self._send(HTTPStatus.OK, render_result(quiz, result, answers, seed))
-            except AnswersError as exc:
+            except ContentError as exc:
                 self._error(HTTPStatus.BAD_REQUEST, exc.message, lang)
             except Exception:
                 traceback.print_exc()

@@ -1,0 +1,62 @@
+"""``multiple``: choose all that apply; the key lists the right option ids.
+
+All or nothing, unless ``partial_credit: true``: then (right picked - wrong picked) /
+right, at least 0.
+"""
+
+from __future__ import annotations
+
+from fractions import Fraction
+from typing import Any
+
+from autograder.core.declarative import Document
+from autograder.i18n import N_, _
+from autograder.quiz.localize import markdown_inline
+from autograder.quiz.model import Question
+from autograder.quiz.types import register
+from autograder.quiz.types.base import (
+    Form,
+    QuestionType,
+    Where,
+    check_option_list_key,
+    option_list_problem,
+    picked_ids,
+)
+from autograder.quiz.views import QuestionView
+
+
+@register
+class MultipleChoice(QuestionType):
+    name = "multiple"
+    form_template = "quiz_types/multiple.html"
+    owned_fields = {"partial_credit": N_("only a multiple question gives partial credit")}
+
+    def check_key(self, doc: Document, q: Question, where: Where) -> None:
+        if not check_option_list_key(doc, q, where):
+            raise doc.error(_("the key must name at least one option"), *where, "answer")
+
+    def answer_problem(self, q: Question, value: Any) -> str | None:
+        return option_list_problem(q, value)
+
+    def credit(self, q: Question, value: Any) -> Fraction:
+        right, chosen = set(q.answer), set(value)
+        if not q.partial_credit:
+            return Fraction(chosen == right)
+        earned = len(chosen & right) - len(chosen - right)
+        return max(Fraction(0), Fraction(earned, len(right)))
+
+    def terminal_lines(self, view: QuestionView) -> list[str]:
+        return [_("Choose all that apply."), *super().terminal_lines(view)]
+
+    def prompt(self, view: QuestionView) -> str:
+        return _("Your answers (numbers separated by commas, Enter to skip)")
+
+    def parse_terminal(self, view: QuestionView, raw: str) -> Any:
+        return picked_ids(view, raw)
+
+    def parse_form(self, q: Question, form: Form) -> Any | None:
+        return [v for v in form.get(f"q:{q.id}", []) if v] or None
+
+    def markdown_lines(self, view: QuestionView) -> list[str]:
+        return [_("Choose all that apply."), "",
+                *(f"- ☐ {markdown_inline(o.text)}" for o in view.options), ""]

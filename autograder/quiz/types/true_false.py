@@ -1,0 +1,52 @@
+"""``true_false``: a statement to judge; the key is ``true`` or ``false``.
+
+Asked like a single-choice question whose two options are True and False, so it keeps
+that type's prompt, parsing, form and Markdown; answers may be ``"true"``/``"false"``
+(option ids, as the form and the terminal give them) or JSON booleans.
+"""
+
+from __future__ import annotations
+
+from fractions import Fraction
+from typing import Any
+
+from autograder.core.declarative import Document
+from autograder.i18n import _
+from autograder.quiz.localize import Localizer, Text
+from autograder.quiz.model import Question, Quiz
+from autograder.quiz.types import register
+from autograder.quiz.types.base import Where, one_option_problem
+from autograder.quiz.types.single import SingleChoice
+from autograder.quiz.views import OptionView
+
+IDS = ("true", "false")
+
+
+@register
+class TrueFalse(SingleChoice):
+    name = "true_false"
+    has_options = False
+
+    def check_key(self, doc: Document, q: Question, where: Where) -> None:
+        if not isinstance(q.answer, bool):
+            raise doc.error(_("the key must be true or false, found {value!r}").format(
+                value=q.answer), *where, "answer")
+
+    def option_ids(self, q: Question) -> tuple[str, ...]:
+        return IDS
+
+    def key(self, q: Question) -> Any:
+        return "true" if q.answer else "false"
+
+    def answer_problem(self, q: Question, value: Any) -> str | None:
+        return None if isinstance(value, bool) else one_option_problem(q, value)
+
+    def credit(self, q: Question, value: Any) -> Fraction:
+        chosen = value if isinstance(value, bool) else value == "true"
+        return Fraction(chosen == q.answer)
+
+    def option_views(self, quiz: Quiz, q: Question, seed: str | int | None,
+                     loc: Localizer) -> tuple[OptionView, ...]:
+        # Always True then False, never shuffled: the order is part of how it reads.
+        return (OptionView("true", Text(_("True"), loc.lang)),
+                OptionView("false", Text(_("False"), loc.lang)))
