@@ -14,7 +14,7 @@ from pathlib import Path
 import click
 
 from autograder import __version__
-from autograder.core.declarative import ContentError
+from autograder.core.errors import ContentError
 from autograder.i18n import LANGUAGES, _, get_language, ngettext, set_language
 from autograder.i18n.cli import i18n_cli
 from autograder.quiz.cli import quiz_cli

@@ -12,8 +12,8 @@ from pathlib import Path
 
 import click
 
-from autograder.core.declarative import ContentError
-from autograder.i18n import _
+from sim.content import ContentError
+from sim.i18n import _
 from sim.worldfile import load_world, world_names, world_path
 
 

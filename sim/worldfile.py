@@ -16,8 +16,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Literal
 
-from autograder.core.declarative import ContentError, Document, build, load_document
-from autograder.i18n import _
+from sim.content import ContentError, Document, build, load_document
+from sim.i18n import _
 
 WORLDS_DIR = Path(__file__).resolve().parent / "worlds"
 ROBOT_RADIUS = 0.105

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from autograder.core.declarative import ContentError
+from sim.content import ContentError
 from sim.worldfile import ROBOT_RADIUS, WorldSpec, load_world, world_names
 
 

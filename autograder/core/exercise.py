@@ -8,8 +8,9 @@ from pathlib import Path
 from typing import Literal
 
 from autograder.core.course import course_root
-from autograder.core.declarative import ContentError, build, load_document
+from autograder.core.errors import ContentError
 from autograder.i18n import _, content_text
+from sim.content import build, load_document
 
 
 def _doc(text: str) -> dict[str, str]:
