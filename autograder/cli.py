@@ -15,7 +15,7 @@ import click
 
 from autograder import __version__
 from autograder.commands.exits import GraderFault, ProblemsFound, UsageProblem
-from autograder.core.declarative import ContentError
+from autograder.core.errors import ContentError
 from autograder.i18n import LANGUAGES, _, get_language, ngettext, set_language
 from autograder.i18n.cli import i18n_cli
 from autograder.quiz.cli import quiz_cli

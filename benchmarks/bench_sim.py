@@ -12,6 +12,7 @@ import os
 import time
 
 from sim.engine import Simulation
+from sim.pacing import DEFAULT_CLOCK_HZ
 from sim.physics import World
 from sim.worldfile import load_world
 
@@ -59,8 +60,8 @@ def main() -> None:
     args = parser.parse_args()
     print(f"physics + lidar, no ROS: RTF {bench_headless(args.sim_seconds):.1f}x")
     overall, window = bench_bridge(args.sim_seconds, args.domain)
-    print(f"with ROS bridge (RTF 0, 50 Hz clock cap): RTF {overall:.1f}x overall, "
-          f"{window:.1f}x at the end")
+    print(f"with ROS bridge (RTF 0, {DEFAULT_CLOCK_HZ:g} Hz clock cap): RTF {overall:.1f}x "
+          f"overall, {window:.1f}x at the end")
 
 
 if __name__ == "__main__":

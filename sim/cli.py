@@ -12,8 +12,9 @@ from pathlib import Path
 
 import click
 
-from autograder.core.declarative import ContentError
-from autograder.i18n import _
+from sim.content import ContentError
+from sim.i18n import _
+from sim.pacing import DEFAULT_CLOCK_HZ
 from sim.worldfile import load_world, world_names, world_path
 
 
@@ -65,7 +66,8 @@ def check_command(file: Path) -> None:
 @click.option("--svg", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="Write a picture of the trajectory here.")
 @click.option("--seed", type=int, default=None, help="Override the world's seed.")
-@click.option("--clock-hz", type=click.FloatRange(min=1.0), default=20.0, show_default=True,
+@click.option("--clock-hz", type=click.FloatRange(min=1.0), default=DEFAULT_CLOCK_HZ,
+              show_default=True,
               help="Most /clock messages per wall second (as graded: Jazzy's "
                    "MultiThreadedExecutor stutters from about 50 Hz).")
 def run_command(world_name: str, rtf: float, duration: float | None, domain: int | None,
@@ -85,7 +87,7 @@ def run_command(world_name: str, rtf: float, duration: float | None, domain: int
 
 def run_world(spec, *, rtf: float, duration: float | None, domain: int,  # noqa: ANN001
               seed: int | None = None, record: Path | None = None,
-              svg: Path | None = None, clock_hz: float = 20.0) -> str:
+              svg: Path | None = None, clock_hz: float = DEFAULT_CLOCK_HZ) -> str:
     """Run ``spec`` on ``domain`` until ``duration`` sim seconds or Ctrl-C; return a summary."""
     import rclpy
     from rclpy.context import Context

@@ -1,23 +1,22 @@
 """Fault injection: corrupted, malformed or missing scans, and obstacles that appear.
 
 Faults come from the world file's ``faults:`` list or are added at run time; each is a
-:class:`sim.worldfile.Fault` active over ``[start, end)`` in sim time.  Faults that pick
-beams draw them from a generator seeded by (world seed, fault index, scan time), so a run
-is reproducible whatever the order or pace of the calls.
+:class:`sim.worldfile.Fault` active over ``[start, end)`` in sim time.  What each kind
+does is in :data:`sim.faultkinds.KINDS`; this module applies them in time.  Faults that
+pick beams draw them from a generator seeded by (world seed, fault index, scan time), so
+a run is reproducible whatever the order or pace of the calls.
 """
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
 
+from sim.faultkinds import KINDS, ScanDraft
 from sim.lidar import Lidar
 from sim.worldfile import Box, Circle, Fault
-
-FAULT_KINDS = ("nan", "inf", "neg_inf", "below_min", "above_max", "empty", "wrong_length",
-               "dropout", "obstacle")
-_BEAM_VALUES = {"nan": np.nan, "inf": np.inf, "neg_inf": -np.inf}
 
 
 @dataclass(frozen=True)
@@ -57,7 +56,7 @@ class FaultInjector:
 
     def add(self, fault: Fault) -> None:
         """Add a fault at run time (it takes effect from its ``start``)."""
-        if fault.kind not in FAULT_KINDS:
+        if fault.kind not in KINDS:
             raise ValueError(f"unknown fault kind {fault.kind!r}")
         self.faults.append(fault)
 
@@ -69,43 +68,27 @@ class FaultInjector:
         """Obstacles whose time has come and that were not placed yet."""
         due: list[Box | Circle] = []
         for i, fault in enumerate(self.faults):
-            if fault.kind == "obstacle" and i not in self._placed and fault.start <= t:
+            places = KINDS[fault.kind].places
+            if places is not None and i not in self._placed and fault.start <= t:
                 self._placed.add(i)
-                obstacle = fault.box or fault.circle
+                obstacle = places(fault)
                 if obstacle is not None:
                     due.append(obstacle)
         return due
 
-    def dropout(self, t: float) -> bool:
-        """True while the sensor publishes nothing at all."""
-        return any(f.kind == "dropout" and _active(f, t) for f in self.faults)
-
     def apply(self, t: float, ranges: np.ndarray) -> Scan | None:
         """The scan to publish at ``t`` from clean ``ranges``, or None during a dropout."""
-        if self.dropout(t):
-            return None
-        ranges = ranges.astype(np.float32)
-        beams, length = len(ranges), len(ranges)
+        scan = ScanDraft(ranges.astype(np.float32), len(ranges), self.lidar)
         for i, fault in enumerate(self.faults):
-            if not _active(fault, t):
-                continue
-            if fault.kind in _BEAM_VALUES or fault.kind in ("below_min", "above_max"):
-                ranges[self._pick(i, t, beams, fault.fraction)] = self._value(fault.kind)
-            elif fault.kind == "wrong_length" and length:
-                # Never the right length by accident: the point is the disagreement.
-                length = fault.length if fault.length != beams else beams - 1
-            elif fault.kind == "empty":
-                length = 0
-        if length != beams:
-            ranges = np.resize(ranges, length)  # repeats readings when asked for more
-        return Scan(t, ranges, np.full(length, 100.0, dtype=np.float32))
-
-    def _value(self, kind: str) -> float:
-        if kind == "below_min":
-            return self.lidar.range_min / 2
-        if kind == "above_max":
-            return self.lidar.range_max + 1.0
-        return _BEAM_VALUES[kind]
+            effect = KINDS[fault.kind].on_scan
+            if effect is not None and _active(fault, t):
+                effect(scan, fault, functools.partial(self._pick, i, t, scan.beams))
+        if scan.dropped:
+            return None
+        out = scan.ranges
+        if scan.length != scan.beams:
+            out = np.resize(out, scan.length)  # repeats readings when asked for more
+        return Scan(t, out, np.full(scan.length, 100.0, dtype=np.float32))
 
     def _pick(self, index: int, t: float, beams: int, fraction: float) -> np.ndarray:
         rng = np.random.default_rng([self.seed, index, round(t * 1e6)])

@@ -14,10 +14,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Literal
 
-from autograder.core.declarative import ContentError, Document, build, load_document
-from autograder.i18n import _
+from sim.content import ContentError, Document, build, load_document
+from sim.faultkinds import KINDS, kind_names
+from sim.i18n import _
 
 WORLDS_DIR = Path(__file__).resolve().parent / "worlds"
 ROBOT_RADIUS = 0.105
@@ -25,9 +25,6 @@ ROBOT_RADIUS = 0.105
 
 Point = tuple[float, float]
 Segment = tuple[Point, Point]
-
-FaultKind = Literal["nan", "inf", "neg_inf", "below_min", "above_max", "empty",
-                    "wrong_length", "dropout", "obstacle"]
 
 
 def _f(default: object, doc: str) -> object:
@@ -95,8 +92,7 @@ class RobotLimits:
 class Fault:
     """A fault to inject: a corrupted or missing scan for a time span, or a new obstacle."""
 
-    kind: FaultKind = field(metadata={"doc": "nan, inf, neg_inf, below_min, above_max, "
-                                             "empty, wrong_length, dropout or obstacle"})
+    kind: str = field(metadata={"doc": kind_names() + " (sim/faultkinds.py)"})
     start: float = _f(0.0, "sim time the fault begins (s)")
     end: float | None = _f(None, "sim time the fault ends (s); none means never")
     fraction: float = _f(0.1, "share of beams affected, for the per-beam kinds (0..1)")
@@ -156,6 +152,22 @@ def _positive(doc: Document, value: float, *where: str | int) -> None:
             field=str(where[-1]), value=value), *where)
 
 
+def _validate_fault_kind(doc: Document, fault: Fault, i: int) -> None:
+    """The kind is in the table, and the file gives only the fields that kind reads."""
+    kind = KINDS.get(fault.kind)
+    if kind is None:
+        raise doc.error(_("must be one of {allowed}, found {value!r}").format(
+            allowed=", ".join(repr(k) for k in KINDS), value=fault.kind), "faults", i, "kind")
+    given = doc.data["faults"][i]  # what the file says, not the defaults filled in
+    extra = sorted(set(given) - {"kind", *kind.fields})
+    if extra:
+        raise doc.error(_("unknown field (expected one of: {known})").format(
+            known=", ".join(("kind", *kind.fields))), "faults", i, extra[0])
+    problem = kind.check(fault) if kind.check else None
+    if problem:
+        raise doc.error(problem, "faults", i, "kind")
+
+
 def _validate(doc: Document, spec: WorldSpec) -> None:
     """Checks the types alone cannot express, each naming the offending field."""
     w, h = spec.size
@@ -171,6 +183,7 @@ def _validate(doc: Document, spec: WorldSpec) -> None:
     for i, circle in enumerate(spec.obstacles.circles):
         _positive(doc, circle.radius, "obstacles", "circles", i, "radius")
     for i, fault in enumerate(spec.faults):
+        _validate_fault_kind(doc, fault, i)
         if not 0.0 <= fault.fraction <= 1.0:
             raise doc.error(_("fraction must be between 0 and 1, found {value}").format(
                 value=fault.fraction), "faults", i, "fraction")
@@ -178,9 +191,6 @@ def _validate(doc: Document, spec: WorldSpec) -> None:
             raise doc.error(_("end must not be before start"), "faults", i, "end")
         if fault.length < 0:
             raise doc.error(_("length must not be negative"), "faults", i, "length")
-        if fault.kind == "obstacle" and (fault.box is None) == (fault.circle is None):
-            raise doc.error(_("an obstacle fault needs exactly one of box or circle"),
-                            "faults", i, "kind")
     if spec.goal is not None:
         _positive(doc, spec.goal.tolerance, "goal", "tolerance")
         if not (0 < spec.goal.x < w and 0 < spec.goal.y < h):

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
-from autograder.core.declarative import ContentError
+from autograder.core.errors import ContentError
 from autograder.i18n import translations
 from autograder.quiz.catalog import list_quizzes, load_all
 from autograder.quiz.cli import quiz_cli

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
-from autograder.core.declarative import ContentError
+from autograder.core.errors import ContentError
 from autograder.quiz.catalog import load_all
 from autograder.quiz.cli import quiz_cli
 from autograder.quiz.model import load_quiz

@@ -12,7 +12,7 @@ from typing import Any
 import pytest
 from click.testing import CliRunner
 
-from autograder.core.declarative import ContentError, Document
+from autograder.core.errors import ContentError, Document
 from autograder.quiz.catalog import load_all
 from autograder.quiz.cli import quiz_cli
 from autograder.quiz.localize import markdown_inline

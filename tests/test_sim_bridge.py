@@ -1,11 +1,12 @@
 """The bridge end to end: a probe node in sim time sees /odom, /scan and /clock, drives
-the robot through /cmd_vel, and the bridge pauses, steps and resets."""
+the robot through /cmd_vel, and the bridge pauses, steps and resets.  The pacing's rules
+are tested without ROS in test_sim_pacing.py; here a real busy process and a real student
+node check that the bridge is paced by them."""
 
 from __future__ import annotations
 
 import math
 import os
-import shutil
 import subprocess
 import sys
 import threading
@@ -23,7 +24,7 @@ from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
 
-from sim.bridge import SimBridge, process_busy
+from sim.bridge import SimBridge
 from sim.physics import World
 from sim.worldfile import Box, load_world
 
@@ -64,7 +65,10 @@ def graph(ros_domain: int) -> Iterator[tuple[SimBridge, Probe]]:
     domain = ros_domain
     ctx = Context()
     rclpy.init(context=ctx, domain_id=domain)
-    bridge = SimBridge(World(load_world("empty_room")), ctx, real_time_factor=2.0)
+    # 50 Hz, not the graded 20: a tick (0.02 s at RTF 1) is then shorter than a busy
+    # process's CPU budget (0.05 s), so holding for it visibly slows the world.
+    bridge = SimBridge(World(load_world("empty_room")), ctx, real_time_factor=2.0,
+                       max_clock_hz=50.0)
     probe = Probe(Node("probe", context=ctx,
                        parameter_overrides=[Parameter("use_sim_time", value=True)]))
     executor = SingleThreadedExecutor(context=ctx)
@@ -157,10 +161,14 @@ def test_watched_process_paces_sim_time(graph: tuple[SimBridge, Probe]) -> None:
     idle = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
     try:
         bridge.watch_pid(busy.pid)
+        before = dict(bridge.pacing)
         slowed = _rtf_over(bridge, 0.4)
+        let_go = bridge.pacing["budget"] - before.get("budget", 0)
         bridge.unwatch_pid(busy.pid)
         bridge.watch_pid(idle.pid)
+        before = dict(bridge.pacing)
         free = _rtf_over(bridge, 0.4)
+        waited_for_idle = bridge.pacing["idle"] - before.get("idle", 0)
     finally:
         bridge.watch_pid(None)
         for proc in (busy, idle):
@@ -169,28 +177,7 @@ def test_watched_process_paces_sim_time(graph: tuple[SimBridge, Probe]) -> None:
     # A tick is 0.02 s of sim time; a busy process gets 0.05 s of CPU before it passes.
     assert slowed < 0.6, slowed
     assert free > 0.85, free
-
-
-@pytest.mark.skipif(os.geteuid() != 0 or shutil.which("taskset") is None,
-                    reason="needs root (nice -20) and taskset to starve a process")
-def test_starved_process_holds_sim_time(graph: tuple[SimBridge, Probe]) -> None:
-    """A process that is runnable but gets no CPU (a busy machine) holds sim time back."""
-    bridge, _ = graph
-    bridge.set_real_time_factor(1.0)
-    spin = [sys.executable, "-c", "while True: pass"]
-    # Both on CPU 0; the hog at nice -20, the "student" at nice 19 gets ~1% of the CPU.
-    hog = subprocess.Popen(["taskset", "-c", "0", "nice", "-n", "-20", *spin])
-    starved = subprocess.Popen(["taskset", "-c", "0", "nice", "-n", "19", *spin])
-    try:
-        bridge.watch_pid(starved.pid)
-        held = _rtf_over(bridge, 0.1)
-    finally:
-        bridge.unwatch_pid(starved.pid)
-        for proc in (hog, starved):
-            proc.kill()
-            proc.wait()
-    # With a 0.05 s wall cap this ran at ~0.4x; with the CPU budget it nearly stops.
-    assert held < 0.1, held
+    assert let_go > 0 and waited_for_idle > 0, bridge.pacing  # what the results report
 
 
 STUDENT = """
@@ -244,8 +231,3 @@ def test_student_process_stops_before_wall(tmp_path, graph: tuple[SimBridge, Pro
         bridge.watch_pid(None)
         student.terminate()
         student.wait(timeout=WALL)
-
-
-def test_process_busy_reads_proc() -> None:
-    assert process_busy(os.getpid())  # this thread is running right now
-    assert not process_busy(2**22 + 12345)  # no such process

@@ -7,8 +7,10 @@ import math
 from pathlib import Path
 
 import pytest
+import yaml
 
-from autograder.core.declarative import ContentError
+from sim.content import ContentError
+from sim.faultkinds import KINDS
 from sim.worldfile import ROBOT_RADIUS, WorldSpec, load_world, world_names
 
 
@@ -67,6 +69,10 @@ BAD = {
     "bad-fraction": ("faults:\n  - {kind: nan, fraction: 2}\n", 2, "faults.0.fraction",
                      "between 0 and 1"),
     "bad-fault-kind": ("faults:\n  - {kind: gremlins}\n", 2, "faults.0.kind", "one of"),
+    "field-of-another-kind": ("faults:\n  - {kind: nan}\n  - {kind: dropout, length: 9}\n",
+                              3, "faults.1.length", "unknown field"),
+    "obstacle-with-end": ("faults:\n  - kind: obstacle\n    box: {center: [1, 1], "
+                          "size: [1, 1]}\n    end: 3\n", 4, "faults.0.end", "unknown field"),
 }
 
 
@@ -97,3 +103,38 @@ def test_missing_required_field_in_a_fault(tmp_path: Path) -> None:
 
 def test_start_pose_angle_is_free() -> None:
     assert math.isclose(load_world("corridor").start.theta, 0.0)
+
+
+
+def _faults_file(tmp_path: Path, *faults: dict[str, object]) -> Path:
+    path = tmp_path / "faults.yaml"
+    path.write_text(yaml.safe_dump({"faults": list(faults)}))
+    return path
+
+
+def _example(kind: str) -> dict[str, object]:
+    """A fault of ``kind`` with every field that kind reads."""
+    values: dict[str, object] = {"start": 1.0, "end": 2.0, "fraction": 0.5, "length": 9,
+                                 "circle": {"center": [1, 1], "radius": 0.2}}
+    return {"kind": kind, **{f: values[f] for f in KINDS[kind].fields if f != "box"}}
+
+
+def test_the_world_file_accepts_exactly_the_kinds_in_the_table(tmp_path: Path) -> None:
+    spec = load_world(_faults_file(tmp_path, *(_example(kind) for kind in KINDS)))
+    assert [f.kind for f in spec.faults] == list(KINDS)
+    with pytest.raises(ContentError) as info:
+        load_world(_faults_file(tmp_path, {"kind": "gremlins"}))
+    assert info.value.field == "faults.0.kind"
+    assert info.value.message == ("must be one of " + ", ".join(repr(k) for k in KINDS)
+                                  + ", found 'gremlins'")
+
+
+@pytest.mark.parametrize("kind", list(KINDS))
+def test_each_kind_takes_only_the_fields_it_reads(tmp_path: Path, kind: str) -> None:
+    others = {"end", "fraction", "length", "box"} - set(KINDS[kind].fields)
+    for field in sorted(others):
+        fault = {**_example(kind), field: {"end": 3.0, "fraction": 0.2, "length": 5,
+                                           "box": {"center": [2, 2], "size": [1, 1]}}[field]}
+        with pytest.raises(ContentError, match="unknown field") as info:
+            load_world(_faults_file(tmp_path, fault))
+        assert info.value.field == f"faults.0.{field}"

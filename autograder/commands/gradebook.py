@@ -13,7 +13,7 @@ import os
 from collections.abc import Iterable
 from pathlib import Path
 
-from autograder.core.declarative import ContentError
+from autograder.core.errors import ContentError
 from autograder.core.results import RunResult, number
 from autograder.i18n import _
 

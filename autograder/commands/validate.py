@@ -8,11 +8,12 @@ from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-from autograder.core.declarative import ContentError, load_document
+from autograder.core.errors import ContentError
 from autograder.core.exercise import Exercise, assignments_dir, load_exercise
 from autograder.core.results import RunResult, number
 from autograder.i18n import _
 from autograder.i18n.tools import Problem
+from sim.content import load_document
 
 
 def _from(exc: ContentError) -> Problem:

@@ -1,6 +1,14 @@
-"""The two exception families: the student's failure, and our own fault."""
+"""The exception families: the student's failure, our own fault, a malformed content file.
+
+:class:`ContentError` (``path:line: field: message``) is defined by the content layer in
+``sim.content``, the lowest layer; the autograder imports it from here.
+"""
 
 from __future__ import annotations
+
+from sim.content import ContentError
+
+__all__ = ["ContentError", "GraderError", "StudentFailure"]
 
 
 class StudentFailure(AssertionError):

@@ -8,8 +8,10 @@ from pathlib import Path
 from typing import Literal
 
 from autograder.core.course import course_root
-from autograder.core.declarative import ContentError, build, load_document
+from autograder.core.errors import ContentError
 from autograder.i18n import _, content_text
+from sim.content import build, load_document
+from sim.pacing import DEFAULT_CLOCK_HZ, DEFAULT_CPU_BUDGET
 
 
 def _doc(text: str) -> dict[str, str]:
@@ -53,10 +55,10 @@ class Exercise:
         "World the tests run in: a name under sim/worlds or a path relative to the exercise."))
     real_time_factor: float = dataclasses.field(default=1.0, metadata=_doc(
         "Pace of simulation time against wall time (0: as fast as the graph keeps up)."))
-    clock_hz: float = dataclasses.field(default=20.0, metadata=_doc(
+    clock_hz: float = dataclasses.field(default=DEFAULT_CLOCK_HZ, metadata=_doc(
         "Most /clock messages per wall second. Jazzy's MultiThreadedExecutor keeps a 10 Hz "
         "sim-time timer exact at 20 Hz but stutters from about 50 Hz (measured)."))
-    cpu_budget: float = dataclasses.field(default=0.05, metadata=_doc(
+    cpu_budget: float = dataclasses.field(default=DEFAULT_CPU_BUDGET, metadata=_doc(
         "CPU seconds the student's process may use after a clock tick before the world "
         "moves on without it. Jazzy's MultiThreadedExecutor can spin for 50-250 ms of CPU "
         "while it hands callbacks to its threads (rclpy issue 1452): raise this for "

@@ -14,6 +14,8 @@ import os
 from functools import cache
 from pathlib import Path
 
+import sim.i18n
+
 DOMAIN = "messages"
 LANGUAGES = ("en", "ur")
 RTL_LANGUAGES = frozenset({"ur", "ar", "fa", "he"})
@@ -55,9 +57,12 @@ def translations(lang: str, domain: str = DOMAIN) -> _gettext.NullTranslations:
 
 
 def set_language(lang: str) -> None:
-    """Make ``lang`` the language of every later ``_`` call in this process."""
+    """Make ``lang`` the language of every later ``_`` call in this process, the
+    simulator's messages included (``sim`` binds its own ``_``: it imports nothing of
+    ``autograder``)."""
     global _active
     _active = lang
+    sim.i18n.set_language(lang, locales_dir)
 
 
 def get_language() -> str:

@@ -13,7 +13,7 @@ import click
 
 from autograder.commands.exits import ProblemsFound, UsageProblem
 from autograder.core.course import course_root
-from autograder.core.declarative import ContentError
+from autograder.core.errors import ContentError
 from autograder.i18n import LANGUAGES, _, locales_dir, ngettext
 from autograder.i18n.tools import check_catalog, compile_catalogs, extract, update
 

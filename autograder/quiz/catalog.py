@@ -6,7 +6,7 @@ import dataclasses
 from pathlib import Path
 
 from autograder.core.course import course_root
-from autograder.core.declarative import ContentError
+from autograder.core.errors import ContentError
 from autograder.i18n import _, content_text
 from autograder.quiz.model import QuizFile, context, load_quiz
 

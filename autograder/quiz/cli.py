@@ -15,7 +15,7 @@ from typing import Any, TypeVar
 import click
 
 from autograder.commands.exits import ProblemsFound, UsageProblem
-from autograder.core.declarative import ContentError
+from autograder.core.errors import ContentError
 from autograder.core.results import RunResult
 from autograder.i18n import (
     LANGUAGES,

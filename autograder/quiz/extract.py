@@ -13,8 +13,8 @@ from collections.abc import Collection, Iterator, Mapping
 from pathlib import Path
 from typing import IO, Any
 
-from autograder.core.declarative import load_document
 from autograder.quiz.model import load_quiz, strings
+from sim.content import load_document
 
 Extracted = tuple[int, str, tuple[str, str], list[str]]
 EXERCISE_FIELDS = ("title", "summary")

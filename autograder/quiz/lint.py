@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from autograder.core.declarative import ContentError
+from autograder.core.errors import ContentError
 from autograder.i18n import locales_dir
 from autograder.i18n.tools import Problem, check_message, read_catalog
 from autograder.quiz import CONTENT_DOMAIN

@@ -1,7 +1,7 @@
 """A quiz file parsed into frozen dataclasses, with every key checked against its options.
 
 The answer key names option ids, never positions or text, so shuffling and translation
-cannot break it.  A malformed file is a :class:`~autograder.core.declarative.ContentError`
+cannot break it.  A malformed file is a :class:`~autograder.core.errors.ContentError`
 naming the file, the line and the field.  What a key and options must look like is up to
 the question's type (``autograder.quiz.types``); the checks here hold for every type.
 """
@@ -15,10 +15,11 @@ from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
-from autograder.core.declarative import ContentError, Document, build, load_document
+from autograder.core.errors import ContentError
 from autograder.core.results import exact
 from autograder.i18n import _
 from autograder.quiz.types import question_type, registry
+from sim.content import Document, build, load_document
 
 ID_PATTERN = re.compile(r"^[a-z0-9][a-z0-9_-]*$")
 

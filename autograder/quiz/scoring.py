@@ -1,6 +1,6 @@
 """Score an answers file against a quiz, exactly, into the one results model.
 
-A bad answers file is a :class:`~autograder.core.declarative.ContentError` naming the file
+A bad answers file is a :class:`~autograder.core.errors.ContentError` naming the file
 and the line, as a bad quiz file is; each question's type checks and scores its answer.
 """
 
@@ -14,7 +14,7 @@ from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
-from autograder.core.declarative import ContentError
+from autograder.core.errors import ContentError
 from autograder.core.results import RunResult, TestResult
 from autograder.i18n import _, ngettext
 from autograder.quiz.localize import Localizer, format_number, format_percent, using_language

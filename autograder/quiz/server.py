@@ -16,7 +16,7 @@ from urllib.parse import parse_qs, urlsplit
 
 from markupsafe import escape
 
-from autograder.core.declarative import ContentError
+from autograder.core.errors import ContentError
 from autograder.i18n import LANGUAGES, _
 from autograder.quiz.localize import using_language
 from autograder.quiz.model import Quiz, QuizFile

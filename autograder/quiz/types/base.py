@@ -13,12 +13,12 @@ from collections.abc import Mapping
 from fractions import Fraction
 from typing import Any, ClassVar
 
-from autograder.core.declarative import Document
 from autograder.i18n import _
 from autograder.quiz.localize import Localizer, format_number, terminal
 from autograder.quiz.model import Option, Question, Quiz, check_id
 from autograder.quiz.shuffle import attempt_rng, shuffle_unpinned
 from autograder.quiz.views import OptionView, QuestionView
+from sim.content import Document
 
 Where = tuple[str | int, ...]
 """Path of a question in its quiz file, ``("questions", index)``, for ``doc.error``."""

@@ -9,7 +9,6 @@ import math
 from fractions import Fraction
 from typing import Any
 
-from autograder.core.declarative import Document
 from autograder.core.results import exact
 from autograder.i18n import N_, _
 from autograder.quiz.localize import markdown_inline
@@ -17,6 +16,7 @@ from autograder.quiz.model import Question
 from autograder.quiz.types import register
 from autograder.quiz.types.base import Form, LintNote, QuestionType, Where, first_value
 from autograder.quiz.views import QuestionView
+from sim.content import Document
 
 # Urdu and Arabic-Indic digits and decimal separator, as a phone keyboard types them.
 _DIGITS = str.maketrans("۰۱۲۳۴۵۶۷۸۹٠١٢٣٤٥٦٧٨٩٫", "01234567890123456789.")

@@ -9,7 +9,6 @@ from __future__ import annotations
 from fractions import Fraction
 from typing import Any
 
-from autograder.core.declarative import Document
 from autograder.i18n import _
 from autograder.quiz.localize import markdown_inline
 from autograder.quiz.model import Option, Question, Quiz
@@ -24,6 +23,7 @@ from autograder.quiz.types.base import (
     picked_ids,
 )
 from autograder.quiz.views import QuestionView
+from sim.content import Document
 
 
 @register

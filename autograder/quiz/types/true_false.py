@@ -10,7 +10,6 @@ from __future__ import annotations
 from fractions import Fraction
 from typing import Any
 
-from autograder.core.declarative import Document
 from autograder.i18n import _
 from autograder.quiz.localize import Localizer, Text
 from autograder.quiz.model import Question, Quiz
@@ -18,6 +17,7 @@ from autograder.quiz.types import register
 from autograder.quiz.types.base import Where, one_option_problem
 from autograder.quiz.types.single import SingleChoice
 from autograder.quiz.views import OptionView
+from sim.content import Document
 
 IDS = ("true", "false")
 

@@ -1,8 +1,13 @@
-"""Declarative content files (exercises, worlds, quizzes): YAML read with line numbers.
+"""Declarative content files (worlds, exercises, quizzes): YAML read with line numbers.
 
 A malformed file is a :class:`ContentError` that names the file, the line and the field,
 so an instructor can go straight to the mistake.  Dataclasses describe each kind of file;
 every field has a default and a ``doc`` in its metadata.
+
+This is the one content layer of the project.  It lives in ``sim`` because world files
+need it and ``sim`` is the lowest layer (it imports nothing of ``autograder``); the
+autograder's exercise and quiz files use it from here, and ``autograder.core.errors``
+re-exports :class:`ContentError` for the rest of the autograder.
 """
 
 from __future__ import annotations
@@ -16,13 +21,13 @@ from typing import Any, TypeVar
 
 import yaml
 
-from autograder.i18n import _
+from sim.i18n import _
 
 T = TypeVar("T")
 
 
 class ContentError(Exception):
-    """A content file an instructor wrote is malformed."""
+    """A content file an instructor wrote is malformed: ``path:line: field: message``."""
 
     def __init__(self, path: Path | str, message: str, line: int | None = None,
                  field: str | None = None) -> None:

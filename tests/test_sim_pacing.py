@@ -1,0 +1,272 @@
+"""The pacing scheduler alone: a fake wall clock and fake student processes, no ROS.
+
+Each test runs ticks the way the bridge does (plan, publish, pace) and checks the wall
+times the ticks went at, the sim time they made, and how the holds ended.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import pytest
+
+from sim.pacing import Pacer, PacingPolicy, Tick
+from sim.procstate import IDLE, ProcessState
+
+DT = 0.005  # the world's physics step
+WALL = 10.0  # real seconds a thread test waits at most for the other thread
+
+
+class FakeClock:
+    """Wall time that moves only when the pacer sleeps or a test says so."""
+
+    def __init__(self) -> None:
+        self.now = 100.0
+        self.waiting = threading.Event()  # set when a thread waits for the pacer to resume
+
+    def monotonic(self) -> float:
+        return self.now
+
+    def sleep(self, seconds: float) -> None:
+        self.now += max(0.0, seconds)
+
+    def wait(self, condition: threading.Condition, predicate: Callable[[], bool]) -> None:
+        self.waiting.set()
+        assert condition.wait_for(predicate, timeout=WALL), "never woken"
+
+
+@dataclass
+class FakeProcess:
+    """A student process as /proc would show it, as a function of the fake time.
+
+    It is busy until ``idle_at`` and meanwhile gets ``cpu_share`` seconds of CPU per wall
+    second (1: it computes; 0: it is runnable but starved of a CPU)."""
+
+    clock: FakeClock
+    idle_at: float = math.inf
+    cpu_share: float = 1.0
+
+    def __call__(self, pid: int) -> ProcessState:
+        now = self.clock.now
+        return ProcessState(busy=now < self.idle_at,
+                            cpu_ns=round(min(now, self.idle_at) * self.cpu_share * 1e9))
+
+
+@dataclass
+class Run:
+    """Ticks driven like the bridge's physics thread, with what each one did."""
+
+    pacer: Pacer
+    clock: FakeClock
+    sim_time: float = 0.0
+    published: list[float] = field(default_factory=list)  # wall time of each tick
+    ticks: list[Tick] = field(default_factory=list)
+
+    def tick(self, work: Callable[[int], float] = lambda steps: 0.0) -> Tick:
+        """One tick: plan it, publish it (taking ``work(steps)`` wall seconds), pace it."""
+        tick = self.pacer.next_tick()
+        assert tick is not None
+        self.published.append(self.clock.now)
+        self.clock.sleep(work(tick.steps))
+        self.sim_time += tick.steps * DT
+        self.pacer.note_tick(self.sim_time)
+        self.pacer.pace(tick)
+        self.ticks.append(tick)
+        return tick
+
+    def ticks_for(self, n: int, work: Callable[[int], float] = lambda steps: 0.0) -> Run:
+        for _ in range(n):
+            self.tick(work)
+        return self
+
+    def gaps(self) -> list[float]:
+        return [b - a for a, b in zip(self.published, self.published[1:], strict=False)]
+
+
+def make(rtf: float = 1.0, process: Callable[[int], ProcessState] | None = None,
+         **policy: float) -> Run:
+    clock = FakeClock()
+    pacer = Pacer(DT, rtf, PacingPolicy(**policy), clock=clock,
+                  read_process=process or (lambda pid: IDLE))
+    return Run(pacer, clock)
+
+
+# -- deadlines -------------------------------------------------------------------------
+@pytest.mark.parametrize("rtf", [0.5, 1.0, 2.0, 4.0])
+def test_ticks_follow_the_real_time_factor(rtf: float) -> None:
+    run = make(rtf).ticks_for(41)
+    assert {t.steps for t in run.ticks} == {round(rtf / 20 / DT)}  # rtf / 20 Hz of sim time
+    assert run.gaps() == pytest.approx([0.05] * 40, abs=1e-9)  # 20 Hz of wall time
+    assert run.pacer.effective_rtf == pytest.approx(rtf)
+    assert run.pacer.counts == {"free": 41}
+
+
+def test_rtf_zero_adapts_the_tick_to_fill_the_clock_period() -> None:
+    """At RTF 0 a tick's work (1 ms per step here) grows to fill 1 / clock_hz."""
+    def work(steps: int) -> float:
+        return steps * 0.001
+
+    run = make(0.0).ticks_for(10, work)
+    assert [t.steps for t in run.ticks[:5]] == [10, 20, 40, 50, 50]  # from 1 / clock_hz
+    run.pacer.forget_rate()
+    run.ticks_for(20, work)
+    assert {t.steps for t in run.ticks[4:]} == {50}  # 50 ms of work: the whole 0.05 s
+    assert all(gap >= 0.05 - 1e-9 for gap in run.gaps())  # still at most 20 per second
+    assert run.pacer.effective_rtf == pytest.approx(5.0)
+
+
+def test_rtf_zero_tick_is_capped_and_shrinks_when_heavy() -> None:
+    run = make(0.0, max_tick=2.0).ticks_for(20, work=lambda steps: steps * 1e-6)
+    assert run.ticks[-1].steps == 400  # max_tick: 2 s of sim time at once
+    heavy = make(0.0).ticks_for(10, work=lambda steps: steps * 0.01)
+    assert heavy.ticks[0].steps == 10 and heavy.ticks[-1].steps == 5  # halved, then fits
+
+
+@pytest.mark.parametrize("clock_hz,rtf", [(20, 1.0), (45, 1.0), (30, 1.0), (20, 0.3),
+                                          (50, 2.0), (7, 3.0), (20, 0.01), (45, 0.0)])
+def test_never_more_than_clock_hz_ticks_per_wall_second(clock_hz: float, rtf: float) -> None:
+    run = make(rtf, clock_hz=clock_hz).ticks_for(60)
+    assert min(run.gaps()) >= 1 / clock_hz - 1e-9
+    if rtf > 0:  # and the sim time still keeps the real-time factor
+        assert run.pacer.effective_rtf == pytest.approx(rtf)
+
+
+def test_no_catch_up_after_a_stall() -> None:
+    """A tick that takes 1 s (a slow publish) moves the schedule; no burst follows."""
+    run = make(1.0)
+    run.ticks_for(5)
+    run.tick(work=lambda steps: 1.0)
+    run.ticks_for(20)
+    gaps = run.gaps()
+    assert gaps[:6] == pytest.approx([0.05] * 5 + [1.0], abs=1e-9)
+    assert gaps[6:] == pytest.approx([0.05] * 19, abs=1e-9)  # on from the late tick
+    assert run.pacer.effective_rtf < 0.9  # sim time just ran slower
+
+
+# -- holding for the student's process -------------------------------------------------
+def test_hold_ends_when_the_process_is_idle() -> None:
+    clock = FakeClock()
+    process = FakeProcess(clock, idle_at=clock.now + 0.03)
+    run = Run(Pacer(DT, 1.0, clock=clock, read_process=process), clock)
+    run.pacer.watch(4242)
+    run.tick()  # idle after 30 ms: before the 50 ms deadline, which it then keeps
+    assert run.pacer.counts == {"idle": 1}
+    assert run.pacer.longest_hold == pytest.approx(0.03, abs=0.001)
+    run.ticks_for(3)
+    assert run.pacer.counts == {"idle": 4}
+    assert run.gaps() == pytest.approx([0.05] * 3, abs=1e-9)
+
+
+@pytest.mark.parametrize("share,hold", [(1.0, 0.05), (0.5, 0.1), (0.25, 0.2)])
+def test_hold_ends_when_the_cpu_budget_is_used(share: float, hold: float) -> None:
+    """A busy process is let go after cpu_budget (50 ms) of CPU, whatever its share."""
+    clock = FakeClock()
+    run = Run(Pacer(DT, 1.0, clock=clock, read_process=FakeProcess(clock, cpu_share=share)),
+              clock)
+    run.pacer.watch(4242)
+    run.ticks_for(5)
+    assert run.pacer.counts == {"budget": 5}
+    # settle (1 ms), then the budget's worth of CPU at this share
+    assert run.pacer.longest_hold == pytest.approx(0.001 + hold, abs=0.001)
+    assert all(gap == pytest.approx(max(0.05, 0.001 + hold), abs=0.001) for gap in run.gaps())
+
+
+def test_a_starved_process_holds_until_the_cap() -> None:
+    """Runnable but no CPU (a busy machine): the world waits for it, up to 2 s a tick."""
+    clock = FakeClock()
+    run = Run(Pacer(DT, 1.0, PacingPolicy(clock_hz=50.0), clock=clock,
+                    read_process=FakeProcess(clock, cpu_share=0.0)), clock)
+    run.pacer.watch(4242)
+    run.ticks_for(6)
+    assert run.pacer.counts == {"cap": 6}
+    assert 2.0 <= run.pacer.longest_hold < 2.0 + 0.001
+    assert run.pacer.effective_rtf < 0.1  # 0.02 s of sim time per 2 s held
+
+
+def test_every_watched_process_must_be_done() -> None:
+    clock = FakeClock()
+    idle_soon, computing = FakeProcess(clock, idle_at=clock.now), FakeProcess(clock)
+    processes = {1: idle_soon, 2: computing}
+    run = Run(Pacer(DT, 1.0, clock=clock, read_process=lambda pid: processes[pid](pid)),
+              clock)
+    run.pacer.watch(1)
+    run.pacer.watch(2)
+    run.tick()
+    assert run.pacer.counts == {"budget": 1}  # one idle, the other had its share
+    run.pacer.unwatch(2)
+    run.tick()
+    assert run.pacer.counts == {"budget": 1, "idle": 1}
+    run.pacer.watch(None)
+    run.tick()
+    assert run.pacer.counts == {"budget": 1, "idle": 1, "free": 1}
+
+
+def test_a_gone_process_reads_idle() -> None:
+    run = make(1.0, process=lambda pid: IDLE)
+    run.pacer.watch(2**22 + 1)
+    run.ticks_for(2)
+    assert run.pacer.counts == {"idle": 2}
+    assert run.pacer.longest_hold == pytest.approx(0.001)  # only the settle
+
+
+def test_a_long_hold_is_not_caught_up() -> None:
+    """After holds of 2 s, the next free ticks keep 1 / clock_hz apart."""
+    clock = FakeClock()
+    process = FakeProcess(clock, cpu_share=0.0, idle_at=clock.now + 5.0)
+    run = Run(Pacer(DT, 1.0, clock=clock, read_process=process), clock)
+    run.pacer.watch(4242)
+    run.ticks_for(10)
+    assert run.pacer.counts == {"cap": 2, "idle": 8}  # the third hold ends at 5 s
+    assert run.gaps()[3:] == pytest.approx([0.05] * 6, abs=1e-9)
+
+
+# -- held, paused, stopped -------------------------------------------------------------
+def test_held_blocks_ticks_until_the_block_ends() -> None:
+    """The start-up hold: a ticking thread waits inside held(); the schedule restarts."""
+    run = make(1.0)
+    run.ticks_for(3)
+    got: list[Tick | None] = []
+    with run.pacer.held():
+        ticker = threading.Thread(target=lambda: got.append(run.pacer.next_tick()))
+        ticker.start()
+        assert run.clock.waiting.wait(WALL)  # it is blocked in next_tick
+        run.clock.sleep(7.0)  # seven wall seconds of start-up pass
+        assert got == [] and run.pacer.paused
+    ticker.join(WALL)
+    assert got and got[0] is not None and not run.pacer.paused
+    run.pacer.pace(got[0])
+    assert run.clock.now == pytest.approx(100.0 + 3 * 0.05 + 7.0 + 0.05)  # one period on
+
+
+def test_held_inside_a_pause_stays_paused() -> None:
+    run = make(1.0)
+    run.pacer.pause()
+    with run.pacer.held():
+        pass
+    assert run.pacer.paused
+    run.pacer.resume()
+    assert run.tick().steps == 10
+
+
+def test_stop_releases_a_waiting_thread() -> None:
+    run = make(1.0)
+    run.pacer.pause()
+    got: list[Tick | None] = []
+    ticker = threading.Thread(target=lambda: got.append(run.pacer.next_tick()))
+    ticker.start()
+    assert run.clock.waiting.wait(WALL)
+    run.pacer.stop()
+    ticker.join(WALL)
+    assert got == [None]
+
+
+def test_bad_settings_are_refused() -> None:
+    with pytest.raises(ValueError):
+        make(-1.0)
+    with pytest.raises(ValueError):
+        make(1.0, clock_hz=0.0)
+    with pytest.raises(ValueError):
+        make(1.0).pacer.set_real_time_factor(-0.5)

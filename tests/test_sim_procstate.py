@@ -1,0 +1,96 @@
+"""Reading a process's state from /proc: busy (running or runnable) and CPU time used."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import time
+from collections.abc import Iterator
+
+import pytest
+
+from sim.pacing import DEFAULT_CPU_BUDGET
+from sim.procstate import IDLE, process_busy, read_process_state
+
+WALL = 20.0
+
+# Prints a line once it is in its loop, so the test knows it is spinning.
+SPIN = [sys.executable, "-c", "print('spinning', flush=True)\nwhile True: pass"]
+
+
+def _spinning() -> subprocess.Popen[str]:
+    proc = subprocess.Popen(SPIN, stdout=subprocess.PIPE, text=True)
+    assert proc.stdout is not None and proc.stdout.readline() == "spinning\n"
+    return proc
+
+
+def _poll(condition, timeout: float = WALL) -> bool:  # noqa: ANN001
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        if condition():
+            return True
+        time.sleep(0.01)
+    return bool(condition())
+
+
+@pytest.fixture
+def spinner() -> Iterator[subprocess.Popen[str]]:
+    proc = _spinning()
+    try:
+        yield proc
+    finally:
+        proc.kill()
+        proc.wait()
+
+
+def test_process_busy_reads_proc() -> None:
+    assert process_busy(os.getpid())  # this thread is running right now
+    assert not process_busy(2**22 + 12345)  # no such process
+    assert read_process_state(2**22 + 12345) == IDLE
+
+
+def test_a_computing_process_is_busy_and_uses_cpu(spinner: subprocess.Popen[str]) -> None:
+    start = read_process_state(spinner.pid)
+    assert start.busy and start.cpu_ns > 0
+    assert _poll(lambda: read_process_state(spinner.pid).cpu_ns > start.cpu_ns + 20_000_000)
+
+
+def test_a_blocked_process_is_idle_and_uses_no_cpu() -> None:
+    proc = subprocess.Popen([sys.executable, "-c", "import sys; sys.stdin.read()"],
+                            stdin=subprocess.PIPE)
+    try:
+        assert _poll(lambda: not process_busy(proc.pid))  # once start-up is over
+        start = read_process_state(proc.pid)
+        samples = []
+        for _ in range(10):  # a tenth of a second of samples
+            samples.append(read_process_state(proc.pid))
+            time.sleep(0.01)
+        assert samples == [start] * 10  # not busy, and no CPU time used
+    finally:
+        proc.kill()
+        proc.wait()
+
+
+@pytest.mark.skipif(not hasattr(os, "sched_setaffinity"), reason="needs sched_setaffinity")
+def test_a_starved_process_is_busy_but_gets_no_cpu() -> None:
+    """Runnable without a CPU (a busy machine) reads busy, with CPU time nearly still: the
+    pacing then holds the world for it (test_sim_pacing's starved process)."""
+    hog, starved = _spinning(), _spinning()
+    try:
+        for proc in (hog, starved):  # both on CPU 0; the "student" at the lowest priority
+            os.sched_setaffinity(proc.pid, {0})
+        os.setpriority(os.PRIO_PROCESS, starved.pid, 19)
+        start = read_process_state(starved.pid)
+        samples = []
+        for _ in range(50):  # half a second of samples
+            samples.append(read_process_state(starved.pid))
+            time.sleep(0.01)
+        used = samples[-1].cpu_ns - start.cpu_ns
+    finally:
+        for proc in (hog, starved):
+            proc.kill()
+            proc.wait()
+    assert all(s.busy for s in samples)
+    # At this rate it would not use its CPU budget within the 2 s cap of a hold.
+    assert used < DEFAULT_CPU_BUDGET * 1e9 / 4, used
