@@ -12,7 +12,7 @@ from typing import Any
 import pytest
 from click.testing import CliRunner
 
-from autograder.core.errors import ContentError, Document
+from autograder.core.errors import ContentError
 from autograder.quiz.catalog import load_all
 from autograder.quiz.cli import quiz_cli
 from autograder.quiz.localize import markdown_inline
@@ -32,6 +32,7 @@ from autograder.quiz.types.base import (
     one_picked_id,
 )
 from autograder.quiz.views import QuestionView, question_views
+from sim.content import Document
 
 REPO = Path(__file__).resolve().parent.parent
 SHIPPED = {"single", "multiple", "true_false", "numeric", "ordering"}
