@@ -4,38 +4,21 @@ The reference solution is the chapter's design (a MultiThreadedExecutor, the pla
 timer in a callback group of its own) and scores 100% five times, with other gradings
 running beside it; the starter scores below the pass mark; other correct designs (a
 worker thread, an awaited future, one reentrant group) score 100%; each known-bad variant
-loses the tests aimed at what it gets wrong.  Gradings run seven at a time.
+loses exactly the tests its expect.yaml names.  Gradings run seven at a time.
 """
 
 from __future__ import annotations
 
 import pytest
-from proving import (  # noqa: F401 - the standard checks, collected here
-    Proof,
-    test_known_bad_variant_loses_the_test_aimed_at_it,
-    test_other_correct_designs_score_full_marks,
-    test_reference_scores_full_marks_every_time,
-    test_starter_is_below_the_pass_mark,
-)
+from proving import Proof
 
 pytestmark = pytest.mark.slow
 
-PROOF = Proof(
-    "timer_sync",
-    correct=('worker_thread', 'async_future', 'reentrant_lock'),
-    mutants={name: frozenset(tests) for name, tests in {
-    "single_threaded": {"test_control_rate", "test_control_while_planning", "test_plan_rate",
-                        "test_rates_at_half_speed"},
-    "shared_group": {"test_control_rate", "test_control_while_planning"},
-    "wall_clock": {"test_rates_at_half_speed"},
-    "wrong_status": {"test_status_counts"},
-    "no_plan_publish": {"test_plan_rate"},
-    }.items()},
-    # Gradings here wait on simulation time at real-time pace, not on the CPU: seven at a
-    # time, two waves for the fourteen (measured: six in parallel beside a busy loop kept
-    # every 10 Hz beat, and seven at a time passed this proof).
-    jobs=7,
-)
+# The submissions and what each must lose: tests/submissions/timer_sync/*/.
+# Gradings here wait on simulation time at real-time pace, not on the CPU: seven at a
+# time, two waves for the fourteen (measured: six in parallel beside a busy loop kept
+# every 10 Hz beat, and seven at a time passed this proof).
+PROOF = Proof("timer_sync", jobs=7)
 
 
 def test_chapter_design_is_the_reference(graded):
