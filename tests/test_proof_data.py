@@ -18,6 +18,7 @@ from proving import (
     apply_patch,
     exercise_tests,
     load_variant,
+    load_variants,
     make_patch,
 )
 
@@ -45,6 +46,16 @@ def test_each_submission_is_a_program_and_an_expectation(folder: Path) -> None:
     assert variant.loses <= exercise_tests(exercise)
     if variant.kind == "correct":
         compile(program, exercise.file, "exec")  # a correct design at least compiles
+
+
+@pytest.mark.parametrize("exercise", EXERCISES)
+def test_known_bad_variants_are_patches(exercise: str) -> None:
+    """A known-bad variant is a patch against the solution, so its flaw reads in a few
+    lines; only correct designs written their own way are whole files."""
+    info = find_exercise(exercise)
+    for name, variant in load_variants(info).items():
+        if variant.kind != "correct":
+            assert (variant.folder / f"{info.file}.patch").exists(), name
 
 
 def expectation(tmp_path: Path, text: str) -> Path:
