@@ -12,6 +12,9 @@ from proving import STANDARD_CHECKS, Proof
 from autograder.core.results import RunResult
 from autograder.sandbox.domains import reserve_domain
 
+# pytester runs pytest in pytest: the grading plugin's reporter is tested that way.
+pytest_plugins = ["pytester"]
+
 
 @pytest.fixture(scope="module")
 def ros_domain() -> Iterator[int]:
