@@ -10,7 +10,10 @@ loses exactly the tests its expect.yaml names.  Gradings run seven at a time.
 from __future__ import annotations
 
 import pytest
+from designs import read_design
 from proving import Proof
+
+from autograder.core.exercise import find_exercise
 
 pytestmark = pytest.mark.slow
 
@@ -21,9 +24,36 @@ pytestmark = pytest.mark.slow
 PROOF = Proof("timer_sync", jobs=7)
 
 
-def test_chapter_design_is_the_reference(graded):
+def departures_from_the_chapter(source: str) -> list[str]:
+    """How a multi-rate controller departs from the chapter's design (nothing: it is it)."""
+    design = read_design(source)
+    planner = design.entity("create_timer", "10.0")  # the 0.1 Hz timer
+    found = []
+    if not design.calls(planner.callback, "plan_route", "self"):
+        found.append("the 0.1 Hz timer does not run the slow planner")
+    if not design.spins_multithreaded():
+        found.append("not spun by a MultiThreadedExecutor")
+    if not design.alone_in_its_group(planner):
+        found.append("the planner is not in a callback group of its own")
+    return found
+
+
+def test_chapter_design_is_the_reference(graded, proof):
     """The reference, which must score 100% every time, is the chapter's own design."""
     assert graded["reference#0"].max_score == 14
+    assert all(graded[f"reference#{i}"].score == 14 for i in range(proof.repeats))
+    exercise = find_exercise("timer_sync")
+    assert departures_from_the_chapter(exercise.solution.read_text()) == []
+    # The check tells the design from others: each departs from it in its own way.
+    departures = {name: departures_from_the_chapter(v.program(exercise))
+                  for name, v in proof.variants.items()}
+    assert departures["shared_group"] == ["the planner is not in a callback group of its own"]
+    assert departures["single_threaded"] == [
+        "not spun by a MultiThreadedExecutor",
+        "the planner is not in a callback group of its own"]
+    assert departures["reentrant_lock"] == [
+        "the planner is not in a callback group of its own"]
+    assert "not spun by a MultiThreadedExecutor" in departures["worker_thread"]
 
 
 def test_frozen_clock_is_explained(graded):
