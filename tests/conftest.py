@@ -1,14 +1,19 @@
-"""Fixtures shared by the project's tests."""
+"""Fixtures shared by the project's tests, and the collection of the exercises' proofs."""
 
 from __future__ import annotations
 
 import os
-from collections.abc import Iterator
-from typing import Any
+from collections.abc import Iterable, Iterator
+from pathlib import Path
 
 import pytest
+from proving import STANDARD_CHECKS, Proof
 
+from autograder.core.results import RunResult
 from autograder.sandbox.domains import reserve_domain
+
+# pytester runs pytest in pytest: the grading plugin's reporter is tested that way.
+pytest_plugins = ["pytester"]
 
 
 @pytest.fixture(scope="module")
@@ -19,24 +24,43 @@ def ros_domain() -> Iterator[int]:
         yield domain
 
 
+# -- the exercises' proofs (tests/proving.py) ------------------------------------------------
+
+class ProofModule(pytest.Module):
+    """A test module that declares ``PROOF``: its own checks, and the standard ones."""
+
+    def collect(self) -> Iterable[pytest.Item | pytest.Collector]:
+        namespace = vars(self.obj)
+        if isinstance(namespace.get("PROOF"), Proof):
+            for check in STANDARD_CHECKS:
+                if namespace.setdefault(check.__name__, check) is not check:
+                    raise pytest.UsageError(f"{self.path}: {check.__name__} is a standard "
+                                            "proof check (tests/proving.py): rename yours")
+        return super().collect()
+
+
+def pytest_pycollect_makemodule(module_path: Path, parent: pytest.Collector) -> pytest.Module:
+    return ProofModule.from_parent(parent, path=module_path)
+
+
 def pytest_generate_tests(metafunc: pytest.Metafunc) -> None:
-    """Parametrize the standard proof checks (tests/proving.py) from the module's PROOF."""
+    """Parametrize the standard checks from the submission folders of the module's PROOF."""
     proof = getattr(metafunc.module, "PROOF", None)
-    if proof is None:
+    if not isinstance(proof, Proof):
         return
     if "correct" in metafunc.fixturenames:
-        metafunc.parametrize("correct", list(proof.correct))
-    if "mutant" in metafunc.fixturenames:
-        metafunc.parametrize("mutant", list(proof.mutants))
+        metafunc.parametrize("correct", proof.named("correct"))
+    if "known_bad" in metafunc.fixturenames:
+        metafunc.parametrize("known_bad", proof.named("mutant", "broken"))
 
 
 @pytest.fixture(scope="module")
-def proof(request: pytest.FixtureRequest) -> Any:
+def proof(request: pytest.FixtureRequest) -> Proof:
     """The module's PROOF (tests/proving.py)."""
     return request.module.PROOF
 
 
 @pytest.fixture(scope="module")
-def graded(proof: Any) -> dict[str, Any]:
+def graded(proof: Proof, tmp_path_factory: pytest.TempPathFactory) -> dict[str, RunResult]:
     """Every submission of the module's PROOF, graded once for all its checks."""
-    return proof.grade_all()
+    return proof.grade_all(tmp_path_factory.mktemp("submissions"))

@@ -1,45 +1,259 @@
 """How every exercise proves its tests: grade its reference solution (several times,
-beside other gradings), its starter, its other correct designs and its known-bad variants,
-then check what each scored.
+beside other gradings), its starter and every submission under
+``tests/submissions/<exercise>/``, then check what each scored.
 
-An exercise's project test declares ``PROOF = Proof(...)`` and imports the standard checks
-below; ``tests/conftest.py`` grades the PROOF once per module (the ``graded`` fixture) and
-parametrizes ``correct`` and ``mutant`` from it.
+A submission folder is data: ``expect.yaml`` says what it is and which tests it must lose,
+as an exact set::
+
+    kind: mutant            # correct | mutant (a known flaw) | broken (does not run right)
+    why: relays linear.x unclamped
+    loses: [test_clamps_linear, test_speed_stays_under_limit]
+
+and the program is either the exercise's file itself (an alternative correct design,
+written its own way) or ``<file>.patch``: a unified diff against the exercise's reference
+solution, so a known-bad variant's flaw reads in a few lines. Patches are applied here,
+in Python, to a copy (no ``patch`` program needed).
+
+An exercise's proof module (``tests/test_grading_<exercise>.py``) declares
+``PROOF = Proof(...)`` and its own special checks; ``tests/conftest.py`` adds the
+STANDARD_CHECKS below to it, grades the PROOF once per module (the ``graded`` fixture) and
+parametrizes ``correct`` and ``known_bad`` from the folders.
+
+    python tests/proving.py losses EXERCISE    # grade everything, print what each lost
+    python tests/proving.py patch FOLDER       # turn a full copy into FILE.patch
 """
 
 from __future__ import annotations
 
+import ast
 import dataclasses
+import difflib
+import functools
 import os
+import re
+import sys
+import tempfile
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-from autograder.core.exercise import find_exercise
+import yaml
+
+from autograder.core.exercise import Exercise, find_exercise
 from autograder.core.results import RunResult
 from autograder.grading.run import grade
 
 SUBMISSIONS = Path(__file__).parent / "submissions"
 # Gradings at a time: two, as `grade-batch --jobs 2` on this 2-core machine.
 JOBS = int(os.environ.get("AUTOGRADER_TEST_JOBS", "2"))
+EXPECT = "expect.yaml"
+KINDS = ("correct", "mutant", "broken")
+# Folders under tests/submissions that are not an exercise's proof (test_hostile.py's).
+NOT_PROOFS = ("hostile",)
 
+
+class PatchError(ValueError):
+    """A patch that is malformed or does not fit the file it is applied to."""
+
+
+# -- patches ---------------------------------------------------------------------------------
+
+_HUNK = re.compile(r"@@ -(\d+)(?:,(\d+))? \+(\d+)(?:,(\d+))? @@")
+
+
+def make_patch(solution: str, variant: str, file: str, name: str) -> str:
+    """The unified diff that turns ``solution`` into ``variant`` (3 lines of context)."""
+    for label, text in (("solution", solution), (name, variant)):
+        if text and not text.endswith("\n"):  # difflib has no "No newline" marker
+            raise PatchError(f"{label}/{file} does not end with a newline")
+    return "".join(difflib.unified_diff(solution.splitlines(keepends=True),
+                                        variant.splitlines(keepends=True),
+                                        f"solution/{file}", f"{name}/{file}"))
+
+
+def apply_patch(original: str, patch: str) -> str:
+    """``original`` with the unified diff ``patch`` applied.
+
+    Every hunk's old lines must match exactly, context included (no fuzz: a patch that
+    no longer fits the solution fails loudly rather than making some other program). A
+    hunk is looked for at the line it names first, then ever further up and down, so
+    lines added or removed elsewhere in the solution only move it.
+    """
+    source = original.splitlines(keepends=True)
+    result: list[str] = []
+    done = 0  # source lines before this are copied or replaced
+    for start, old, new in _hunks(patch):
+        at = _find(source, old, start, done)
+        if at is None:
+            raise PatchError(f"hunk at line {start + 1} does not match the file:\n"
+                             + "".join(old))
+        result += source[done:at] + new
+        done = at + len(old)
+    return "".join(result + source[done:])
+
+
+def _hunks(patch: str) -> list[tuple[int, list[str], list[str]]]:
+    """Each hunk as (0-based line it starts at, old lines, new lines)."""
+    lines = patch.splitlines(keepends=True)
+    hunks: list[tuple[int, list[str], list[str]]] = []
+    i = 0
+    while i < len(lines):
+        match = _HUNK.match(lines[i])
+        i += 1
+        if match is None:
+            if hunks:  # only the ---/+++ header may come before the first hunk
+                raise PatchError(f"not a hunk: {lines[i - 1]!r}")
+            continue
+        old_count = int(match[2] if match[2] is not None else 1)
+        new_count = int(match[4] if match[4] is not None else 1)
+        # An empty old side names the line *after which* the new lines go.
+        start = int(match[1]) - (1 if old_count else 0)
+        old: list[str] = []
+        new: list[str] = []
+        tag = ""
+        while len(old) < old_count or len(new) < new_count \
+                or (i < len(lines) and lines[i].startswith("\\")):
+            if i >= len(lines):
+                raise PatchError(f"hunk {match[0]} ends early")
+            line = lines[i]
+            i += 1
+            if line.startswith("\\"):  # "\ No newline at end of file": the line before
+                for side, tags in ((old, " -"), (new, " +")):
+                    if tag and tag in tags:
+                        side[-1] = side[-1].removesuffix("\n")
+                continue
+            if line in ("\n", "\r\n"):  # a blank context line whose space an editor trimmed
+                line = " " + line
+            tag = line[:1]
+            if tag not in (" ", "-", "+"):
+                raise PatchError(f"hunk {match[0]}: unexpected line {line!r}")
+            if tag in " -":
+                old.append(line[1:])
+            if tag in " +":
+                new.append(line[1:])
+        if len(old) != old_count or len(new) != new_count:
+            raise PatchError(f"hunk {match[0]}: line counts do not match")
+        hunks.append((start, old, new))
+    if not hunks:
+        raise PatchError("no hunks")
+    return hunks
+
+
+def _find(source: list[str], old: list[str], start: int, earliest: int) -> int | None:
+    """Where ``old`` occurs in ``source`` at or after ``earliest``, nearest ``start``."""
+    last = len(source) - len(old)
+    for offset in range(max(start - earliest, last - start) + 1):
+        for at in (start - offset, start + offset):
+            if earliest <= at <= last and source[at:at + len(old)] == old:
+                return at
+    return None
+
+
+# -- submissions -----------------------------------------------------------------------------
+
+@dataclasses.dataclass(frozen=True)
+class Variant:
+    """One submission folder of an exercise's proof, and what it must lose."""
+
+    name: str
+    folder: Path
+    kind: str
+    why: str
+    loses: frozenset[str]
+
+    def program(self, exercise: Exercise) -> str:
+        """The submitted file's text: the folder's own copy, or the patched solution."""
+        own = self.folder / exercise.file
+        if own.exists():
+            return own.read_text(encoding="utf-8")
+        patch = self.folder / f"{exercise.file}.patch"
+        try:
+            return apply_patch(exercise.solution.read_text(encoding="utf-8"),
+                               patch.read_text(encoding="utf-8"))
+        except PatchError as exc:
+            raise PatchError(f"{patch}: {exc}") from None
+
+    def submission(self, exercise: Exercise, workdir: Path) -> Path:
+        """A folder to grade: the variant's own, or a copy in ``workdir`` with the patch
+        applied."""
+        if (self.folder / exercise.file).exists():
+            return self.folder
+        target = workdir / self.name
+        target.mkdir(parents=True, exist_ok=True)
+        (target / exercise.file).write_text(self.program(exercise), encoding="utf-8")
+        return target
+
+
+def load_variant(folder: Path, exercise: Exercise) -> Variant:
+    """A submission folder and its ``expect.yaml``, checked: a typo in an expectation must
+    not quietly weaken a proof."""
+    path = folder / EXPECT
+
+    def wrong(what: str) -> ValueError:
+        return ValueError(f"{path}: {what}")
+
+    if not path.exists():
+        raise wrong("missing: every submission folder says what it must lose")
+    data = yaml.safe_load(path.read_text(encoding="utf-8"))
+    if not isinstance(data, dict) or set(data) != {"kind", "why", "loses"}:
+        raise wrong("needs exactly the keys kind, why and loses")
+    kind, why, loses = data["kind"], data["why"], data["loses"]
+    if kind not in KINDS:
+        raise wrong(f"kind must be one of {', '.join(KINDS)}, not {kind!r}")
+    if not isinstance(why, str) or not why.strip() or "\n" in why.strip():
+        raise wrong("why must be one line")
+    if not isinstance(loses, list) or not all(isinstance(t, str) for t in loses) \
+            or len(set(loses)) != len(loses):
+        raise wrong("loses must be a list of distinct test names")
+    if (kind == "correct") != (not loses):
+        raise wrong("a correct design loses no test; every other kind loses some")
+    unknown = set(loses) - exercise_tests(exercise)
+    if unknown:
+        raise wrong(f"no such tests in {exercise.id}: {', '.join(sorted(unknown))}")
+    files = [p for p in (folder / exercise.file, folder / f"{exercise.file}.patch")
+             if p.exists()]
+    if len(files) != 1:
+        raise wrong(f"needs {exercise.file} or {exercise.file}.patch, and only one")
+    return Variant(folder.name, folder, kind, why.strip(), frozenset(loses))
+
+
+def load_variants(exercise: Exercise) -> dict[str, Variant]:
+    folder = SUBMISSIONS / exercise.id
+    return {p.name: load_variant(p, exercise) for p in sorted(folder.iterdir()) if p.is_dir()}
+
+
+@functools.cache
+def exercise_tests(exercise: Exercise) -> frozenset[str]:
+    """The names of the exercise's test functions, public and hidden (read, not imported)."""
+    names: set[str] = set()
+    for path in sorted(exercise.folder.glob("tests/**/test_*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef) \
+                    and node.name.startswith("test"):
+                names.add(node.name)
+    return frozenset(names)
+
+
+# -- the proof -------------------------------------------------------------------------------
 
 @dataclasses.dataclass(frozen=True)
 class Proof:
     exercise: str
-    correct: tuple[str, ...] = ()
-    # Each known-bad variant, and the tests aimed at what it gets wrong.
-    mutants: dict[str, frozenset[str]] = dataclasses.field(default_factory=dict)
-    broken: tuple[str, ...] = ()
     repeats: int = 5
     jobs: int = JOBS
 
-    def grade_all(self) -> dict[str, RunResult]:
+    @functools.cached_property
+    def variants(self) -> dict[str, Variant]:
+        return load_variants(find_exercise(self.exercise))
+
+    def named(self, *kinds: str) -> list[str]:
+        return [name for name, v in self.variants.items() if v.kind in kinds]
+
+    def grade_all(self, workdir: Path) -> dict[str, RunResult]:
         exercise = find_exercise(self.exercise)
-        folder = SUBMISSIONS / self.exercise
         jobs: dict[str, Path | None] = {f"reference#{i}": None for i in range(self.repeats)}
         jobs["starter"] = exercise.starter
-        for name in [*self.correct, *self.mutants, *self.broken]:
-            jobs[name] = folder / name
+        for name, variant in self.variants.items():
+            jobs[name] = variant.submission(exercise, workdir)
         with ThreadPoolExecutor(max_workers=self.jobs) as pool:
             futures = {name: pool.submit(grade, exercise, path) for name, path in jobs.items()}
             return {name: future.result() for name, future in futures.items()}
@@ -54,7 +268,8 @@ def failures(result: RunResult) -> dict[str, str]:
     return {t.name: f"{t.status}: {t.message}" for t in result.tests if t.status != "passed"}
 
 
-def test_reference_scores_full_marks_every_time(graded, proof):
+def test_reference_scores_full_marks_every_time(graded: dict[str, RunResult],
+                                                proof: Proof) -> None:
     results = [graded[f"reference#{i}"] for i in range(proof.repeats)]
     assert [r.grader_error for r in results] == [None] * proof.repeats
     assert all(r.score == r.max_score for r in results), [failures(r) for r in results]
@@ -62,21 +277,82 @@ def test_reference_scores_full_marks_every_time(graded, proof):
     assert all(r.passed for r in results)
 
 
-def test_starter_is_below_the_pass_mark(graded):
+def test_starter_is_below_the_pass_mark(graded: dict[str, RunResult]) -> None:
     result = graded["starter"]
     assert result.grader_error is None
     assert not result.passed
     assert result.score < result.max_score * result.pass_mark
 
 
-def test_other_correct_designs_score_full_marks(graded, correct):
+def test_other_correct_designs_score_full_marks(graded: dict[str, RunResult],
+                                                correct: str) -> None:
     result = graded[correct]
     assert result.grader_error is None
     assert result.score == result.max_score, failures(result)
 
 
-def test_known_bad_variant_loses_the_test_aimed_at_it(graded, proof, mutant):
-    result = graded[mutant]
+def test_known_bad_variant_loses_exactly_the_tests_aimed_at_it(
+        graded: dict[str, RunResult], proof: Proof, known_bad: str) -> None:
+    """Exactly: a variant that loses more than intended points at a test that checks more
+    than its name says, or at a flaw other than the one its folder names."""
+    result = graded[known_bad]
+    variant = proof.variants[known_bad]
     assert result.grader_error is None
     assert result.score < result.max_score
-    assert proof.mutants[mutant] <= failed_tests(result), failures(result)
+    lost = failed_tests(result)
+    assert lost == variant.loses, {"why": variant.why, "lost": failures(result),
+                                   "passed, though expected lost": sorted(variant.loses - lost)}
+
+
+# What every exercise's proof checks: tests/conftest.py adds these to each module that
+# declares PROOF, parametrized from its submission folders (``correct``, ``known_bad``).
+STANDARD_CHECKS = (test_reference_scores_full_marks_every_time,
+                   test_starter_is_below_the_pass_mark,
+                   test_other_correct_designs_score_full_marks,
+                   test_known_bad_variant_loses_exactly_the_tests_aimed_at_it)
+
+
+# -- tools -----------------------------------------------------------------------------------
+
+def _losses(exercise_id: str) -> None:
+    """Grade every submission of an exercise and print what each lost, beside what its
+    ``expect.yaml`` says: where an expectation comes from."""
+    proof = Proof(exercise_id)
+    with tempfile.TemporaryDirectory() as tmp:
+        results = proof.grade_all(Path(tmp))
+    for name, result in results.items():
+        lost = sorted(failed_tests(result))
+        variant = proof.variants.get(name)
+        mark = "" if variant is None or set(lost) == variant.loses else "  # differs"
+        print(f"{name}: score {result.score}/{result.max_score}, "
+              f"grader_error {result.grader_error}{mark}\n  loses: [{', '.join(lost)}]")
+
+
+def _patch(folder: Path) -> None:
+    """Replace a variant's full copy with a patch against the solution, after checking
+    that the patch gives the copy back byte for byte."""
+    exercise = find_exercise(folder.resolve().parent.name)
+    copy = folder / exercise.file
+    solution, variant = (p.read_text(encoding="utf-8") for p in (exercise.solution, copy))
+    patch = make_patch(solution, variant, exercise.file, folder.name)
+    if apply_patch(solution, patch) != variant:
+        raise PatchError(f"{copy}: the patch does not give the file back")
+    (folder / f"{exercise.file}.patch").write_text(patch, encoding="utf-8")
+    copy.unlink()
+    print(f"{copy}: {len(variant.splitlines())} lines -> patch of {len(patch.splitlines())}")
+
+
+def main(argv: list[str]) -> int:
+    if len(argv) == 2 and argv[0] == "losses":
+        _losses(argv[1])
+    elif len(argv) >= 2 and argv[0] == "patch":
+        for folder in argv[1:]:
+            _patch(Path(folder))
+    else:
+        print(__doc__)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

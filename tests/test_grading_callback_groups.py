@@ -4,47 +4,65 @@ The reference solution is the chapter's design (a MultiThreadedExecutor; the ser
 a callback group of its own waits on a condition that the scan callback, in another
 group, notifies) and scores 100% five times, with other gradings running beside it; the
 starter scores below the pass mark; other correct designs (requests served one at a
-time, an awaited future on one thread) score 100%; each known-bad variant loses the
-tests aimed at what it gets wrong, and a node spinning Jazzy's EventsExecutor (which runs
+time, an awaited future on one thread) score 100%; each known-bad variant loses exactly
+the tests its expect.yaml names, and a node spinning Jazzy's EventsExecutor (which runs
 no callback, burns a core and ignores SIGINT) still ends with a score.
 """
 
 from __future__ import annotations
 
 import pytest
-from proving import (  # noqa: F401 - the standard checks, collected here
-    Proof,
-    test_known_bad_variant_loses_the_test_aimed_at_it,
-    test_other_correct_designs_score_full_marks,
-    test_reference_scores_full_marks_every_time,
-    test_starter_is_below_the_pass_mark,
-)
+from designs import read_design
+from proving import Proof
 
 from autograder.core.exercise import find_exercise
 
 pytestmark = pytest.mark.slow
 
-PROOF = Proof(
-    "callback_groups",
-    correct=('serial_service', 'async_future'),
-    mutants={name: frozenset(tests) for name, tests in {
-    "old_scan": {"test_answer_uses_newer_scan", "test_no_fresh_scan"},
-    "deadlock": {"test_open_space", "test_concurrent_requests", "test_never_deadlocks"},
-    "shared_group": {"test_open_space", "test_concurrent_requests"},
-    "events_executor": {"test_node_starts", "test_open_space", "test_never_deadlocks"},
-    "wrong_threshold": {"test_box_ahead"},
-    "ignores_invalid_readings": {"test_ignores_invalid_readings"},
-    "no_rate_topic": {"test_scan_rate"},
-    }.items()},
-    # Gradings here wait on simulation time at real-time pace, not on the CPU: five at a
-    # time (measured: six in parallel beside a busy loop kept every 10 Hz beat).
-    jobs=5,
-)
+# The submissions and what each must lose: tests/submissions/callback_groups/*/.
+# Gradings here wait on simulation time at real-time pace, not on the CPU: five at a time
+# (measured: six in parallel beside a busy loop kept every 10 Hz beat).
+PROOF = Proof("callback_groups", jobs=5)
 
 
-def test_chapter_design_is_the_reference(graded):
+def departures_from_the_chapter(source: str) -> list[str]:
+    """How a safety supervisor departs from the chapter's design (nothing: it is it)."""
+    design = read_design(source)
+    service = design.entity("create_service", "'check_path'")
+    scan = design.entity("create_subscription", "'scan'")
+    found = []
+    if not design.spins_multithreaded():
+        found.append("not spun by a MultiThreadedExecutor")
+    if not design.alone_in_its_group(service):
+        found.append("the service is not in a callback group of its own")
+    if scan.group not in design.groups or scan.group == service.group:
+        found.append("the scan callback is not in another group of the node's")
+    if not any(design.calls(service.callback, "wait", c)
+               and (design.calls(scan.callback, "notify_all", c)
+                    or design.calls(scan.callback, "notify", c))
+               for c in design.made_as("Condition")):
+        found.append("the service does not wait on a condition the scan callback notifies")
+    return found
+
+
+def test_chapter_design_is_the_reference(graded, proof):
     """The reference, which must score 100% every time, is the chapter's own design."""
     assert graded["reference#0"].max_score == 13
+    assert all(graded[f"reference#{i}"].score == 13 for i in range(proof.repeats))
+    exercise = find_exercise("callback_groups")
+    assert departures_from_the_chapter(exercise.solution.read_text()) == []
+    # The check tells the design from others: each departs from it in its own way.
+    departures = {name: departures_from_the_chapter(v.program(exercise))
+                  for name, v in proof.variants.items()}
+    assert departures["shared_group"] == [
+        "the service is not in a callback group of its own",
+        "the scan callback is not in another group of the node's"]
+    assert departures["events_executor"] == ["not spun by a MultiThreadedExecutor"]
+    assert departures["old_scan"] == [
+        "the service does not wait on a condition the scan callback notifies"]
+    assert "not spun by a MultiThreadedExecutor" in departures["deadlock"]
+    assert "not spun by a MultiThreadedExecutor" in departures["async_future"]
+    assert departures["serial_service"] == []  # the chapter's design, one request at a time
 
 
 def test_events_executor_ends_with_a_score_and_a_reason(graded):

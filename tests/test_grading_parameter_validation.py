@@ -2,42 +2,19 @@
 
 The reference solution scores 100% (five times, with other gradings running beside it),
 the starter scores below the pass mark, every other correct design scores 100%, each
-known-bad variant loses the test aimed at it, and broken programs get a score and a plain
-message.
+known-bad variant loses exactly the tests its expect.yaml names, and broken programs get a
+score and a plain message.
 """
 
 from __future__ import annotations
 
 import pytest
-from proving import (  # noqa: F401 - the standard checks, collected here
-    Proof,
-    failed_tests,
-    test_known_bad_variant_loses_the_test_aimed_at_it,
-    test_other_correct_designs_score_full_marks,
-    test_reference_scores_full_marks_every_time,
-    test_starter_is_below_the_pass_mark,
-)
+from proving import Proof, failed_tests
 
 pytestmark = pytest.mark.slow
 
-PROOF = Proof(
-    "parameter_validation",
-    correct=("descriptor_ranges", "pre_post_callbacks", "read_each_message", "multithreaded"),
-    mutants={
-        "no_linear_clamp": frozenset({"test_clamps_linear", "test_speed_stays_under_limit"}),
-        "no_angular_clamp": frozenset({"test_clamps_angular"}),
-        "accepts_out_of_range": frozenset({"test_refuses_out_of_range"}),
-        "accepts_empty_name": frozenset({"test_refuses_empty_robot_name"}),
-        "silent_refusal": frozenset({"test_refuses_out_of_range",
-                                     "test_refuses_empty_robot_name"}),
-        "ignores_invalid_override": frozenset({"test_invalid_override_exits"}),
-        "stale_limits": frozenset({"test_accepted_value_applies"}),
-        "double_publish": frozenset({"test_one_output_per_input"}),
-        "keeps_other_fields": frozenset({"test_other_fields_zero"}),
-    },
-    broken=("syntax_error", "crash_at_start", "never_spins", "wrong_node_name"),
-    jobs=3,
-)
+# The submissions and what each must lose: tests/submissions/parameter_validation/*/.
+PROOF = Proof("parameter_validation", jobs=3)
 
 
 def test_reference_max_score_is_the_exercise_points(graded):

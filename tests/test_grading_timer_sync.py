@@ -4,43 +4,56 @@ The reference solution is the chapter's design (a MultiThreadedExecutor, the pla
 timer in a callback group of its own) and scores 100% five times, with other gradings
 running beside it; the starter scores below the pass mark; other correct designs (a
 worker thread, an awaited future, one reentrant group) score 100%; each known-bad variant
-loses the tests aimed at what it gets wrong.  Gradings run seven at a time.
+loses exactly the tests its expect.yaml names.  Gradings run seven at a time.
 """
 
 from __future__ import annotations
 
 import pytest
-from proving import (  # noqa: F401 - the standard checks, collected here
-    Proof,
-    test_known_bad_variant_loses_the_test_aimed_at_it,
-    test_other_correct_designs_score_full_marks,
-    test_reference_scores_full_marks_every_time,
-    test_starter_is_below_the_pass_mark,
-)
+from designs import read_design
+from proving import Proof
+
+from autograder.core.exercise import find_exercise
 
 pytestmark = pytest.mark.slow
 
-PROOF = Proof(
-    "timer_sync",
-    correct=('worker_thread', 'async_future', 'reentrant_lock'),
-    mutants={name: frozenset(tests) for name, tests in {
-    "single_threaded": {"test_control_rate", "test_control_while_planning", "test_plan_rate",
-                        "test_rates_at_half_speed"},
-    "shared_group": {"test_control_rate", "test_control_while_planning"},
-    "wall_clock": {"test_rates_at_half_speed"},
-    "wrong_status": {"test_status_counts"},
-    "no_plan_publish": {"test_plan_rate"},
-    }.items()},
-    # Gradings here wait on simulation time at real-time pace, not on the CPU: seven at a
-    # time, two waves for the fourteen (measured: six in parallel beside a busy loop kept
-    # every 10 Hz beat, and seven at a time passed this proof).
-    jobs=7,
-)
+# The submissions and what each must lose: tests/submissions/timer_sync/*/.
+# Gradings here wait on simulation time at real-time pace, not on the CPU: seven at a
+# time, two waves for the fourteen (measured: six in parallel beside a busy loop kept
+# every 10 Hz beat, and seven at a time passed this proof).
+PROOF = Proof("timer_sync", jobs=7)
 
 
-def test_chapter_design_is_the_reference(graded):
+def departures_from_the_chapter(source: str) -> list[str]:
+    """How a multi-rate controller departs from the chapter's design (nothing: it is it)."""
+    design = read_design(source)
+    planner = design.entity("create_timer", "10.0")  # the 0.1 Hz timer
+    found = []
+    if not design.calls(planner.callback, "plan_route", "self"):
+        found.append("the 0.1 Hz timer does not run the slow planner")
+    if not design.spins_multithreaded():
+        found.append("not spun by a MultiThreadedExecutor")
+    if not design.alone_in_its_group(planner):
+        found.append("the planner is not in a callback group of its own")
+    return found
+
+
+def test_chapter_design_is_the_reference(graded, proof):
     """The reference, which must score 100% every time, is the chapter's own design."""
     assert graded["reference#0"].max_score == 14
+    assert all(graded[f"reference#{i}"].score == 14 for i in range(proof.repeats))
+    exercise = find_exercise("timer_sync")
+    assert departures_from_the_chapter(exercise.solution.read_text()) == []
+    # The check tells the design from others: each departs from it in its own way.
+    departures = {name: departures_from_the_chapter(v.program(exercise))
+                  for name, v in proof.variants.items()}
+    assert departures["shared_group"] == ["the planner is not in a callback group of its own"]
+    assert departures["single_threaded"] == [
+        "not spun by a MultiThreadedExecutor",
+        "the planner is not in a callback group of its own"]
+    assert departures["reentrant_lock"] == [
+        "the planner is not in a callback group of its own"]
+    assert "not spun by a MultiThreadedExecutor" in departures["worker_thread"]
 
 
 def test_frozen_clock_is_explained(graded):

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 import socket
 import subprocess
@@ -210,7 +211,18 @@ def test_no_network_beyond_loopback(graded, target_host):
 
 
 def test_runs_as_its_own_user_where_strict(graded):
-    isolation = graded["detached_daemon"][0].data["isolation"]
+    """The program (and the daemon it leaves behind) prints the uid it really runs as:
+    the run's own user in strict isolation, never the grader's; the grader's user in basic
+    isolation, and the results say why."""
+    result = graded["detached_daemon"][0]
+    isolation = result.data["isolation"]
     assert isolation["mode"] == detect().mode
-    if isolation["mode"] == "basic":
+    seen = {int(uid) for uid in re.findall(r"^STUDENT UID (\d+)$", result.log, re.M)}
+    if isolation["mode"] == "strict":
+        assert result.data["student_uid"] is not None
+        assert seen == {result.data["student_uid"]}
+        assert os.getuid() not in seen
+    else:
+        assert result.data["student_uid"] is None
+        assert seen == {os.getuid()}
         assert isolation["reason"]  # the results say why

@@ -1,4 +1,6 @@
-"""Hostile: starts a daemon in a new session that would outlive the node."""
+"""Hostile: starts a daemon in a new session that would outlive the node.
+
+Both say which user they run as: the grader checks it is the run's own (strict isolation)."""
 
 import rclpy
 from rclpy.executors import ExternalShutdownException
@@ -22,6 +24,7 @@ def _daemon():
     if os.fork() == 0:
         os.setsid()
         if os.fork() == 0:
+            print("STUDENT UID", os.getuid(), flush=True)
             while True:
                 time.sleep(1)
         os._exit(0)
@@ -29,6 +32,8 @@ def _daemon():
 
 
 def main(args=None):
+    import os
+    print("STUDENT UID", os.getuid(), flush=True)
     _daemon()
     rclpy.init(args=args)
     node = Shouter()

@@ -1,0 +1,140 @@
+"""The proofs' data, checked without grading: every submission folder says what it must
+lose in a well-formed expect.yaml, every patch still fits its exercise's reference
+solution, and the patches are applied exactly (tests/proving.py).
+
+The proofs themselves (tests/test_grading_*.py) take minutes; a stale patch or a typo in an
+expectation shows here in a second.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from proving import (
+    NOT_PROOFS,
+    SUBMISSIONS,
+    PatchError,
+    apply_patch,
+    exercise_tests,
+    load_variant,
+    load_variants,
+    make_patch,
+)
+
+from autograder.core.exercise import find_exercise
+
+TESTS = Path(__file__).parent
+EXERCISES = sorted(p.name for p in SUBMISSIONS.iterdir() if p.name not in NOT_PROOFS)
+FOLDERS = [SUBMISSIONS / e / v for e in EXERCISES for v in sorted(
+    p.name for p in (SUBMISSIONS / e).iterdir() if p.is_dir())]
+
+
+@pytest.mark.parametrize("exercise", EXERCISES)
+def test_each_exercise_with_submissions_has_its_proof_module(exercise: str) -> None:
+    module = TESTS / f"test_grading_{exercise}.py"
+    assert module.exists()
+    assert f'PROOF = Proof("{exercise}"' in module.read_text()
+
+
+@pytest.mark.parametrize("folder", FOLDERS, ids=lambda f: f"{f.parent.name}/{f.name}")
+def test_each_submission_is_a_program_and_an_expectation(folder: Path) -> None:
+    exercise = find_exercise(folder.parent.name)
+    variant = load_variant(folder, exercise)  # raises on anything malformed
+    program = variant.program(exercise)
+    assert program != exercise.solution.read_text(encoding="utf-8")
+    assert variant.loses <= exercise_tests(exercise)
+    if variant.kind == "correct":
+        compile(program, exercise.file, "exec")  # a correct design at least compiles
+
+
+@pytest.mark.parametrize("exercise", EXERCISES)
+def test_known_bad_variants_are_patches(exercise: str) -> None:
+    """A known-bad variant is a patch against the solution, so its flaw reads in a few
+    lines; only correct designs written their own way are whole files."""
+    info = find_exercise(exercise)
+    for name, variant in load_variants(info).items():
+        if variant.kind != "correct":
+            assert (variant.folder / f"{info.file}.patch").exists(), name
+
+
+def expectation(tmp_path: Path, text: str) -> Path:
+    folder = tmp_path / "submissions" / "bad"
+    folder.mkdir(parents=True)
+    (folder / "expect.yaml").write_text(text)
+    (folder / "velocity_governor.py").write_text("pass\n")
+    return folder
+
+
+@pytest.mark.parametrize("text,problem", [
+    ("kind: mutant\nwhy: x\nloses: []\n", "every other kind loses some"),
+    ("kind: correct\nwhy: x\nloses: [test_node_starts]\n", "a correct design loses no test"),
+    ("kind: mutant\nwhy: x\nloses: [test_no_such_thing]\n", "no such tests"),
+    ("kind: mutant\nwhy: x\nloses: [test_node_starts, test_node_starts]\n", "distinct"),
+    ("kind: mutatn\nwhy: x\nloses: [test_node_starts]\n", "kind must be one of"),
+    ("kind: mutant\nloses: [test_node_starts]\n", "exactly the keys"),
+    ("kind: mutant\nwhy: x\nloses: [test_node_starts]\naimed: []\n", "exactly the keys"),
+])
+def test_a_malformed_expectation_is_refused(tmp_path: Path, text: str, problem: str) -> None:
+    """A typo must not quietly weaken a proof."""
+    folder = expectation(tmp_path, text)
+    with pytest.raises(ValueError, match=problem):
+        load_variant(folder, find_exercise("parameter_validation"))
+
+
+def test_a_folder_with_both_a_file_and_a_patch_is_refused(tmp_path: Path) -> None:
+    folder = expectation(tmp_path, "kind: mutant\nwhy: x\nloses: [test_node_starts]\n")
+    (folder / "velocity_governor.py.patch").write_text("")
+    with pytest.raises(ValueError, match="only one"):
+        load_variant(folder, find_exercise("parameter_validation"))
+
+
+SOLUTION = "".join(f"line {i}\n" for i in range(1, 21))
+
+
+def edited(text: str) -> str:
+    return text.replace("line 3\n", "line three\n").replace("line 15\n", "").replace(
+        "line 20\n", "line 20\nline 21\n")
+
+
+def test_a_patch_gives_the_variant_back() -> None:
+    patch = make_patch(SOLUTION, edited(SOLUTION), "f.py", "v")
+    assert patch.startswith("--- solution/f.py\n+++ v/f.py\n@@ ")
+    assert apply_patch(SOLUTION, patch) == edited(SOLUTION)
+
+
+def test_a_patch_follows_lines_that_moved() -> None:
+    """Lines added above a hunk move it; the hunk is found where its context now is."""
+    patch = make_patch(SOLUTION, edited(SOLUTION), "f.py", "v")
+    moved = "new 1\nnew 2\n" + SOLUTION.replace("line 10\n", "")
+    assert apply_patch(moved, patch) == "new 1\nnew 2\n" + edited(SOLUTION).replace(
+        "line 10\n", "")
+
+
+def test_a_patch_that_no_longer_fits_fails_loudly() -> None:
+    patch = make_patch(SOLUTION, edited(SOLUTION), "f.py", "v")
+    with pytest.raises(PatchError, match="does not match"):
+        apply_patch(SOLUTION.replace("line 14\n", "line fourteen\n"), patch)
+
+
+def test_a_blank_context_line_trimmed_by_an_editor_still_applies() -> None:
+    solution, variant = "a\n\nb\nc\n", "a\n\nB\nc\n"
+    patch = make_patch(solution, variant, "f.py", "v")
+    assert "\n \n" in patch
+    assert apply_patch(solution, patch.replace("\n \n", "\n\n")) == variant
+
+
+def test_no_newline_at_end_of_file() -> None:
+    patch = ("--- a\n+++ b\n@@ -1,2 +1,2 @@\n a\n-b\n\\ No newline at end of file\n"
+             "+B\n\\ No newline at end of file\n")
+    assert apply_patch("a\nb", patch) == "a\nB"
+
+
+@pytest.mark.parametrize("patch,problem", [
+    ("--- a\n+++ b\n", "no hunks"),
+    ("--- a\n+++ b\n@@ -1,2 +1,2 @@\n a\n", "ends early"),
+    ("--- a\n+++ b\n@@ -1,1 +1,1 @@\n?a\n", "unexpected line"),
+])
+def test_a_malformed_patch_is_refused(patch: str, problem: str) -> None:
+    with pytest.raises(PatchError, match=problem):
+        apply_patch("a\n", patch)

@@ -1,0 +1,287 @@
+"""The grading plugin's reporter (autograder.plugin.GradingReporter), run in an inner pytest.
+
+Each test writes an exercise's test files into a minimal exercise folder, runs pytest on
+them with ``--exercise`` and ``--autograder-report``, and reads the signed report: how each
+outcome is classified (the student's failure, our error, a skip), partial credit, a
+failing teardown, points and visibility. These are the verdicts every grading is built
+from, checked without a simulator or a student process.
+"""
+
+from __future__ import annotations
+
+import textwrap
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from autograder.core.output import CUT, MESSAGE_BYTES
+from autograder.core.signing import Forged, verify
+
+EXERCISE_YAML = """\
+id: mini
+title: "Mini: the reporter's exercise"
+file: mini.py
+node: mini
+hidden_visibility: hidden
+"""
+
+
+def grade_tests(pytester: pytest.Pytester, public: str, hidden: str = "",
+                *args: str) -> dict[str, dict[str, Any]]:
+    """Run the given public (and hidden) test code as an exercise's tests; the report's
+    entry of each test, by name."""
+    folder = pytester.path / "mini"
+    (folder / "tests" / "public").mkdir(parents=True)
+    (folder / "exercise.yaml").write_text(EXERCISE_YAML)
+    (folder / "tests" / "public" / "test_public.py").write_text(textwrap.dedent(public))
+    folders = [folder / "tests" / "public"]
+    if hidden:
+        (folder / "tests" / "hidden").mkdir()
+        (folder / "tests" / "hidden" / "test_hidden.py").write_text(textwrap.dedent(hidden))
+        folders.append(folder / "tests" / "hidden")
+    report = pytester.path / "report.json"
+    pytester.runpytest("-p", "no:cacheprovider", "--exercise", str(folder),
+                       "--autograder-report", str(report), *args, *map(str, folders))
+    # No key was given: the report is signed with the empty key, and only with it.
+    text = report.read_text()
+    with pytest.raises(Forged):
+        verify(text, b"another key")
+    return {entry["name"]: entry for entry in verify(text, b"")["tests"]}
+
+
+def test_a_pass_is_passed_with_its_label_and_one_point(pytester: pytest.Pytester) -> None:
+    tests = grade_tests(pytester, '''
+        def test_ok():
+            """The node starts.
+
+            More words the student does not see in the label."""
+    ''')
+    entry = tests["test_ok"]
+    assert (entry["status"], entry["message"], entry["hint"]) == ("passed", "", "")
+    assert entry["label"] == "The node starts."
+    assert entry["max_score"] == 1
+    assert entry["done"] is True
+    assert (entry["visibility"], entry["reveal"]) == ("visible", "message")
+
+
+def test_a_student_failure_is_failed_with_its_message_and_hint(
+        pytester: pytest.Pytester) -> None:
+    tests = grade_tests(pytester, '''
+        from autograder.core.errors import StudentFailure
+
+        def test_clamps():
+            raise StudentFailure("cmd_vel had 3.0", "clamp linear.x")
+    ''')
+    entry = tests["test_clamps"]
+    assert (entry["status"], entry["message"], entry["hint"]) == (
+        "failed", "cmd_vel had 3.0", "clamp linear.x")
+    assert "StudentFailure" in entry["details"]  # the traceback, for the instructor
+
+
+def test_a_failed_assertion_is_failed_with_its_message(pytester: pytest.Pytester) -> None:
+    tests = grade_tests(pytester, '''
+        def test_speed():
+            speed = 3.0
+            assert speed <= 0.5, f"the robot reached {speed} m/s"
+    ''')
+    entry = tests["test_speed"]
+    assert entry["status"] == "failed"
+    # The student reads the message, not pytest's rewritten comparison below it.
+    assert entry["message"] == "the robot reached 3.0 m/s"
+    assert "assert 3.0 <= 0.5" in entry["details"]
+
+
+def test_any_other_exception_is_a_grader_error(pytester: pytest.Pytester) -> None:
+    """A bug in a test is ours: reported as an error, never as the student's zero."""
+    tests = grade_tests(pytester, '''
+        from autograder.core.errors import GraderError
+
+        def test_buggy():
+            {}["missing"]
+
+        def test_world_died():
+            raise GraderError("the simulator stopped")
+    ''')
+    assert tests["test_buggy"]["status"] == "error"
+    assert tests["test_buggy"]["message"] == "KeyError: 'missing'"
+    assert "KeyError" in tests["test_buggy"]["details"]
+    assert tests["test_world_died"]["status"] == "error"
+    assert tests["test_world_died"]["message"] == "grader error: the simulator stopped"
+
+
+def test_a_skip_is_skipped_with_its_reason(pytester: pytest.Pytester) -> None:
+    tests = grade_tests(pytester, '''
+        import pytest
+
+        def test_later():
+            pytest.skip("needs the corridor world")
+
+        @pytest.mark.skip(reason="not in this term")
+        def test_marked():
+            pass
+    ''')
+    assert (tests["test_later"]["status"], tests["test_later"]["message"]) == (
+        "skipped", "needs the corridor world")
+    assert (tests["test_marked"]["status"], tests["test_marked"]["message"]) == (
+        "skipped", "not in this term")
+
+
+def test_partial_credit_is_a_failure_with_its_fraction(pytester: pytest.Pytester) -> None:
+    tests = grade_tests(pytester, '''
+        def test_most_of_the_way(credit):
+            credit.award(0.25, "a quarter of the way", "drive on to the goal")
+
+        def test_all_of_the_way(credit):
+            credit.award(1.0, "there")
+
+        def test_more_than_all(credit):
+            credit.award(1.7, "beyond")
+
+        def test_less_than_nothing(credit):
+            credit.award(-0.5, "backwards")
+
+        def test_award_then_fail(credit):
+            credit.award(0.5, "half")
+            assert False, "then it crashed"
+    ''')
+    entry = tests["test_most_of_the_way"]
+    assert (entry["status"], entry["fraction"], entry["message"], entry["hint"]) == (
+        "failed", 0.25, "a quarter of the way", "drive on to the goal")
+    # A whole award is a pass (the fraction is clamped to [0, 1]); no award is kept.
+    for name in ("test_all_of_the_way", "test_more_than_all"):
+        assert (tests[name]["status"], tests[name]["message"]) == ("passed", ""), name
+        assert "fraction" not in tests[name]
+    assert (tests["test_less_than_nothing"]["status"],
+            tests["test_less_than_nothing"]["fraction"]) == ("failed", 0.0)
+    # A failure after an award is a failure: the award is not kept.
+    entry = tests["test_award_then_fail"]
+    assert (entry["status"], entry["message"]) == ("failed", "then it crashed")
+    assert "fraction" not in entry
+
+
+def test_a_teardown_failure_after_a_pass_is_classified(pytester: pytest.Pytester) -> None:
+    """As the graph guard does: a fixture that finds tampering after the test fails it."""
+    tests = grade_tests(pytester, '''
+        import pytest
+        from autograder.core.errors import StudentFailure
+
+        @pytest.fixture
+        def guard():
+            yield
+            raise StudentFailure("tampering seen", "publish only your topics")
+
+        @pytest.fixture
+        def broken_cleanup():
+            yield
+            raise RuntimeError("could not stop the world")
+
+        def test_guarded(guard):
+            pass
+
+        def test_cleaned_up(broken_cleanup):
+            pass
+
+        def test_failed_then_guarded(guard):
+            raise StudentFailure("wrong answer")
+    ''')
+    assert (tests["test_guarded"]["status"], tests["test_guarded"]["message"],
+            tests["test_guarded"]["hint"]) == ("failed", "tampering seen",
+                                               "publish only your topics")
+    assert (tests["test_cleaned_up"]["status"], tests["test_cleaned_up"]["message"]) == (
+        "error", "RuntimeError: could not stop the world")
+    # The test's own failure is what it is reported with, not its teardown's.
+    assert (tests["test_failed_then_guarded"]["status"],
+            tests["test_failed_then_guarded"]["message"]) == ("failed", "wrong answer")
+
+
+def test_a_setup_failure_is_the_students(pytester: pytest.Pytester) -> None:
+    """As when the student's node never starts: the `student` fixture raises."""
+    tests = grade_tests(pytester, '''
+        import pytest
+        from autograder.core.errors import StudentFailure
+
+        @pytest.fixture
+        def student():
+            raise StudentFailure("no node named 'mini'", "create the node")
+
+        def test_needs_node(student):
+            pass
+    ''')
+    entry = tests["test_needs_node"]
+    assert (entry["status"], entry["message"], entry["hint"]) == (
+        "failed", "no node named 'mini'", "create the node")
+
+
+def test_points_and_visibility_come_from_markers_and_folders(
+        pytester: pytest.Pytester) -> None:
+    tests = grade_tests(pytester, '''
+        import pytest
+
+        @pytest.mark.points(3)
+        def test_worth_three():
+            pass
+
+        @pytest.mark.visibility("after_published")
+        def test_shown_later():
+            pass
+    ''', '''
+        import pytest
+
+        def test_secret():
+            pass
+
+        @pytest.mark.visibility("visible")
+        @pytest.mark.reveal("message")
+        def test_open_secret():
+            pass
+    ''')
+    assert tests["test_worth_three"]["max_score"] == 3
+    assert tests["test_shown_later"]["max_score"] == 1
+    assert (tests["test_worth_three"]["visibility"], tests["test_worth_three"]["reveal"]) == (
+        "visible", "message")
+    assert (tests["test_shown_later"]["visibility"], tests["test_shown_later"]["reveal"]) == (
+        "after_published", "status")
+    # Under tests/hidden/: the exercise's hidden_visibility, and only the status shown.
+    assert (tests["test_secret"]["visibility"], tests["test_secret"]["reveal"]) == (
+        "hidden", "status")
+    assert (tests["test_open_secret"]["visibility"],
+            tests["test_open_secret"]["reveal"]) == ("visible", "message")
+
+
+def test_a_test_that_never_ran_is_an_error_saying_so(pytester: pytest.Pytester) -> None:
+    """A run that ends early (here at the first failure) leaves the rest as not run."""
+    tests = grade_tests(pytester, '''
+        def test_first():
+            assert False, "first"
+
+        def test_second():
+            pass
+    ''', "", "-x")
+    assert tests["test_first"]["status"] == "failed"
+    entry = tests["test_second"]
+    assert (entry["status"], entry["done"]) == ("error", False)
+    assert entry["message"].startswith("Not run")
+
+
+def test_a_long_message_is_cut_to_a_few_kilobytes(pytester: pytest.Pytester) -> None:
+    """Its start and its end, with a mark between (every results format repeats it)."""
+    tests = grade_tests(pytester, '''
+        from autograder.core.errors import StudentFailure
+
+        def test_chatty():
+            raise StudentFailure("start" + "x" * 100_000 + "end")
+    ''')
+    message = tests["test_chatty"]["message"]
+    assert message.startswith("start") and message.endswith("end")
+    assert f"\n{CUT}\n" in message
+    assert len(message.encode()) <= MESSAGE_BYTES + len(f"\n{CUT}\n".encode())
+
+
+def test_without_exercise_the_plugin_writes_nothing(pytester: pytest.Pytester) -> None:
+    """Inert unless --exercise is given: the project's own suite runs beside it."""
+    pytester.makepyfile("def test_plain():\n    pass\n")
+    result = pytester.runpytest("-p", "no:cacheprovider",
+                                "--autograder-report", str(pytester.path / "r.json"))
+    result.assert_outcomes(passed=1)
+    assert not Path(pytester.path / "r.json").exists()
