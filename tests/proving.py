@@ -159,6 +159,10 @@ class Variant:
     kind: str
     why: str
     loses: frozenset[str]
+    # Tests a wrong *timing* design may lose or not depending on how fast the world runs
+    # next to other gradings (a wall-clock timer against a lagging world): named, with
+    # the reason in expect.yaml, never a blanket allowance.
+    may_also_lose: frozenset[str] = frozenset()
 
     def program(self, exercise: Exercise) -> str:
         """The submitted file's text: the folder's own copy, or the patched solution."""
@@ -194,9 +198,15 @@ def load_variant(folder: Path, exercise: Exercise) -> Variant:
     if not path.exists():
         raise wrong("missing: every submission folder says what it must lose")
     data = yaml.safe_load(path.read_text(encoding="utf-8"))
-    if not isinstance(data, dict) or set(data) != {"kind", "why", "loses"}:
-        raise wrong("needs exactly the keys kind, why and loses")
+    if not isinstance(data, dict) or not {"kind", "why", "loses"} <= set(data) \
+            or set(data) - {"kind", "why", "loses", "may_also_lose"}:
+        raise wrong("needs the keys kind, why and loses (and may have may_also_lose)")
     kind, why, loses = data["kind"], data["why"], data["loses"]
+    may = data.get("may_also_lose", [])
+    if not isinstance(may, list) or not all(isinstance(t, str) for t in may) \
+            or set(may) & set(loses) or (may and kind != "mutant"):
+        raise wrong("may_also_lose lists a mutant's load-dependent tests, none of them in "
+                    "loses")
     if kind not in KINDS:
         raise wrong(f"kind must be one of {', '.join(KINDS)}, not {kind!r}")
     if not isinstance(why, str) or not why.strip() or "\n" in why.strip():
@@ -206,14 +216,14 @@ def load_variant(folder: Path, exercise: Exercise) -> Variant:
         raise wrong("loses must be a list of distinct test names")
     if (kind == "correct") != (not loses):
         raise wrong("a correct design loses no test; every other kind loses some")
-    unknown = set(loses) - exercise_tests(exercise)
+    unknown = (set(loses) | set(may)) - exercise_tests(exercise)
     if unknown:
         raise wrong(f"no such tests in {exercise.id}: {', '.join(sorted(unknown))}")
     files = [p for p in (folder / exercise.file, folder / f"{exercise.file}.patch")
              if p.exists()]
     if len(files) != 1:
         raise wrong(f"needs {exercise.file} or {exercise.file}.patch, and only one")
-    return Variant(folder.name, folder, kind, why.strip(), frozenset(loses))
+    return Variant(folder.name, folder, kind, why.strip(), frozenset(loses), frozenset(may))
 
 
 def load_variants(exercise: Exercise) -> dict[str, Variant]:
@@ -300,8 +310,10 @@ def test_known_bad_variant_loses_exactly_the_tests_aimed_at_it(
     assert result.grader_error is None
     assert result.score < result.max_score
     lost = failed_tests(result)
-    assert lost == variant.loses, {"why": variant.why, "lost": failures(result),
-                                   "passed, though expected lost": sorted(variant.loses - lost)}
+    assert variant.loses <= lost <= variant.loses | variant.may_also_lose, {
+        "why": variant.why, "lost": failures(result),
+        "passed, though expected lost": sorted(variant.loses - lost),
+        "lost, though not expected": sorted(lost - variant.loses - variant.may_also_lose)}
 
 
 # What every exercise's proof checks: tests/conftest.py adds these to each module that
@@ -323,7 +335,9 @@ def _losses(exercise_id: str) -> None:
     for name, result in results.items():
         lost = sorted(failed_tests(result))
         variant = proof.variants.get(name)
-        mark = "" if variant is None or set(lost) == variant.loses else "  # differs"
+        fits = variant is None or variant.loses <= set(lost) <= \
+            variant.loses | variant.may_also_lose
+        mark = "" if fits else "  # differs"
         print(f"{name}: score {result.score}/{result.max_score}, "
               f"grader_error {result.grader_error}{mark}\n  loses: [{', '.join(lost)}]")
 

@@ -72,8 +72,13 @@ def expectation(tmp_path: Path, text: str) -> Path:
     ("kind: mutant\nwhy: x\nloses: [test_no_such_thing]\n", "no such tests"),
     ("kind: mutant\nwhy: x\nloses: [test_node_starts, test_node_starts]\n", "distinct"),
     ("kind: mutatn\nwhy: x\nloses: [test_node_starts]\n", "kind must be one of"),
-    ("kind: mutant\nloses: [test_node_starts]\n", "exactly the keys"),
-    ("kind: mutant\nwhy: x\nloses: [test_node_starts]\naimed: []\n", "exactly the keys"),
+    ("kind: mutant\nloses: [test_node_starts]\n", "needs the keys kind, why and loses"),
+    ("kind: mutant\nwhy: x\nloses: [test_node_starts]\naimed: []\n",
+     "needs the keys kind, why and loses"),
+    ("kind: correct\nwhy: x\nloses: []\nmay_also_lose: [test_node_starts]\n",
+     "may_also_lose lists a mutant's"),
+    ("kind: mutant\nwhy: x\nloses: [test_node_starts]\nmay_also_lose: [test_node_starts]\n",
+     "may_also_lose lists a mutant's"),
 ])
 def test_a_malformed_expectation_is_refused(tmp_path: Path, text: str, problem: str) -> None:
     """A typo must not quietly weaken a proof."""
