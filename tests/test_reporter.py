@@ -1,7 +1,8 @@
 """The grading plugin's reporter (autograder.plugin.GradingReporter), run in an inner pytest.
 
 Each test writes an exercise's test files into a minimal exercise folder, runs pytest on
-them with ``--exercise`` and ``--autograder-report``, and reads the signed report: how each
+them with the grader's settings document (``--autograder-settings``: the exercise and the
+report's path), and reads the signed report: how each
 outcome is classified (the student's failure, our error, a skip), partial credit, a
 failing teardown, points and visibility. These are the verdicts every grading is built
 from, checked without a simulator or a student process.
@@ -10,12 +11,12 @@ from, checked without a simulator or a student process.
 from __future__ import annotations
 
 import textwrap
-from pathlib import Path
 from typing import Any
 
 import pytest
 
 from autograder.core.output import CUT, MESSAGE_BYTES
+from autograder.core.settings import RunSettings
 from autograder.core.signing import Forged, verify
 
 EXERCISE_YAML = """\
@@ -41,8 +42,9 @@ def grade_tests(pytester: pytest.Pytester, public: str, hidden: str = "",
         (folder / "tests" / "hidden" / "test_hidden.py").write_text(textwrap.dedent(hidden))
         folders.append(folder / "tests" / "hidden")
     report = pytester.path / "report.json"
-    pytester.runpytest("-p", "no:cacheprovider", "--exercise", str(folder),
-                       "--autograder-report", str(report), *args, *map(str, folders))
+    settings = RunSettings(exercise=str(folder), report=str(report))
+    pytester.runpytest("-p", "no:cacheprovider", "--autograder-settings", settings.to_json(),
+                       *args, *map(str, folders))
     # No key was given: the report is signed with the empty key, and only with it.
     text = report.read_text()
     with pytest.raises(Forged):
@@ -151,13 +153,13 @@ def test_partial_credit_is_a_failure_with_its_fraction(pytester: pytest.Pytester
     # A whole award is a pass (the fraction is clamped to [0, 1]); no award is kept.
     for name in ("test_all_of_the_way", "test_more_than_all"):
         assert (tests[name]["status"], tests[name]["message"]) == ("passed", ""), name
-        assert "fraction" not in tests[name]
+        assert tests[name]["fraction"] is None  # no award kept
     assert (tests["test_less_than_nothing"]["status"],
             tests["test_less_than_nothing"]["fraction"]) == ("failed", 0.0)
     # A failure after an award is a failure: the award is not kept.
     entry = tests["test_award_then_fail"]
     assert (entry["status"], entry["message"]) == ("failed", "then it crashed")
-    assert "fraction" not in entry
+    assert entry["fraction"] is None
 
 
 def test_a_teardown_failure_after_a_pass_is_classified(pytester: pytest.Pytester) -> None:
@@ -279,9 +281,8 @@ def test_a_long_message_is_cut_to_a_few_kilobytes(pytester: pytest.Pytester) -> 
 
 
 def test_without_exercise_the_plugin_writes_nothing(pytester: pytest.Pytester) -> None:
-    """Inert unless --exercise is given: the project's own suite runs beside it."""
+    """Inert unless an exercise is graded: the project's own suite runs beside it."""
     pytester.makepyfile("def test_plain():\n    pass\n")
-    result = pytester.runpytest("-p", "no:cacheprovider",
-                                "--autograder-report", str(pytester.path / "r.json"))
+    result = pytester.runpytest("-p", "no:cacheprovider")
     result.assert_outcomes(passed=1)
-    assert not Path(pytester.path / "r.json").exists()
+    assert not list(pytester.path.glob("*.json"))

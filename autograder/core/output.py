@@ -74,10 +74,10 @@ def size_note(total: int, budget: int) -> str:
 
 
 def clip_middle(text: str, max_bytes: int) -> str:
-    """``text`` in at most about ``max_bytes``: its start and end, a mark between them."""
+    """``text`` in at most ``max_bytes``: its start and end, a mark between them."""
     if _utf8_len(text) <= max_bytes:
         return text
-    half = max_bytes // 2
+    half = (max_bytes - _utf8_len(f"\n{CUT}\n")) // 2  # the mark counts too
     start = _fit_bytes(text, half).removesuffix(CUT)
     raw_end = text.encode("utf-8", "replace")[-half:]
     return f"{start}\n{CUT}\n{raw_end.decode('utf-8', 'ignore')}"
