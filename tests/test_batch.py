@@ -17,6 +17,7 @@ import pytest
 
 from autograder.commands.batch import in_shard
 from autograder.core.exercise import find_exercise
+from autograder.core.settings import RunSettings
 from autograder.grading.run import grade
 
 pytestmark = pytest.mark.slow
@@ -127,8 +128,9 @@ def run_folders(processes: set[tuple[int, str]]) -> set[Path]:
             args = Path(f"/proc/{pid}/cmdline").read_bytes().split(b"\0")
         except OSError:
             continue
-        if b"--autograder-report" in args:
-            found.add(Path(args[args.index(b"--autograder-report") + 1].decode()).parent)
+        if b"--autograder-settings" in args:
+            settings = RunSettings.from_json(args[args.index(b"--autograder-settings") + 1])
+            found.add(Path(settings.report).parent)
     return found
 
 
