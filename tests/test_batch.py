@@ -3,6 +3,7 @@ scores as one by one; resumable after being killed halfway; sharded and merged."
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import os
 import re
@@ -134,6 +135,12 @@ def run_folders(processes: set[tuple[int, str]]) -> set[Path]:
     return found
 
 
+def finished(folder: Path) -> bool:
+    """Whether a grading's pytest child ran to its summary line (an orphan would)."""
+    log = folder / "pytest.log"
+    return bool(re.search(r"\d+ (passed|failed|error)", log.read_text() if log.exists() else ""))
+
+
 def descendants(pid: int) -> set[tuple[int, str]]:
     """The processes below ``pid`` (with their start times, so a reused pid is not them)."""
     table = _processes()
@@ -159,19 +166,28 @@ def test_batch_resumes_after_being_killed(tmp_path, submissions, one_by_one, cou
     while len(list(out.glob("*/results.json"))) < 4 and time.monotonic() < deadline:
         assert first.poll() is None, first.stdout.read()
         time.sleep(0.2)
+    # Freeze the gradings, so that what each had done when the batch died is known
+    # exactly (a grading may be printing its summary at that very moment), then kill the
+    # batch and let them go on: each must end without running on.
     running = descendants(first.pid)
-    folders = run_folders(running)
+    for pid, _start in running:
+        with contextlib.suppress(ProcessLookupError):
+            os.kill(pid, signal.SIGSTOP)
+    folders = {folder: finished(folder) for folder in run_folders(running)}
     assert folders, "the batch had no grading running when it was killed"
     os.killpg(first.pid, signal.SIGKILL)
     first.wait()
+    for pid, _start in running:
+        with contextlib.suppress(ProcessLookupError):
+            os.kill(pid, signal.SIGCONT)
     deadline = time.monotonic() + 60
     while alive(running) and time.monotonic() < deadline:
         time.sleep(0.1)
     assert not alive(running), f"left running after the batch was killed: {alive(running)}"
-    for folder in folders:  # the dead batch could not remove them; ended, not finished:
-        log = (folder / "pytest.log").read_text()  # an orphan would have run to its summary
-        assert not re.search(r"\d+ (passed|failed|error)", log), log[-2000:]
+    for folder, was_finished in folders.items():  # the dead batch could not remove them
+        assert finished(folder) == was_finished, (folder / "pytest.log").read_text()[-2000:]
         shutil.rmtree(folder, ignore_errors=True)
+    assert not all(folders.values()), "every grading had finished: the kill proved nothing"
     done_before = {p.parent.name for p in out.glob("*/results.json")}
     assert 4 <= len(done_before) < len(KINDS)
     second = batch(args, course_env)
