@@ -14,9 +14,9 @@ from pathlib import Path
 import click
 
 from autograder import __version__
-from autograder.commands.exits import GraderFault, ProblemsFound, UsageProblem
+from autograder.commands.exits import GraderFault, UsageProblem, report_problems
 from autograder.core.errors import ContentError
-from autograder.i18n import LANGUAGES, _, get_language, ngettext, set_language
+from autograder.i18n import LANGUAGES, _, get_language, set_language
 from autograder.i18n.cli import i18n_cli
 from autograder.quiz.cli import quiz_cli
 from sim.cli import sim_cli
@@ -367,11 +367,7 @@ def validate(run_gradings: bool, jobs: int, course: Path | None) -> None:
     problems = check_course(course, run_gradings=run_gradings, jobs=jobs,
                             progress=lambda e: click.echo(_("grading {exercise}...").format(
                                 exercise=e), err=True))
-    for problem in problems:
-        click.echo(str(problem), err=True)
-    if problems:
-        raise ProblemsFound(ngettext("{count} problem found", "{count} problems found",
-                                len(problems)).format(count=len(problems)))
+    report_problems(problems)
     click.echo(_("The course is valid."))
 
 

@@ -52,11 +52,18 @@ def locales_dir() -> Path:
     return _find_locales() if _find_locales else _CHECKOUT_LOCALES
 
 
+def load_catalog(folder: Path, lang: str, domain: str = DOMAIN) -> _gettext.NullTranslations:
+    """The ``domain`` catalog of ``lang`` in ``folder`` (``locales/<lang>/LC_MESSAGES``):
+    its ``.mo`` if at least as new as its ``.po``, else the ``.po`` compiled in memory;
+    a null catalog where there is neither. Read again when either file changes."""
+    stamp = (_mtime(folder / f"{domain}.po"), _mtime(folder / f"{domain}.mo"))
+    return _catalog(folder, lang, domain, stamp)
+
+
 @cache
-def _catalog(lang: str, folder: Path, stamp: tuple[float, float]) -> _gettext.NullTranslations:
-    """The catalog of ``lang`` in ``folder``; ``stamp`` (the files' mtimes) is part of the
-    key so that an edited ``.po`` is read again."""
-    po, mo = folder / f"{DOMAIN}.po", folder / f"{DOMAIN}.mo"
+def _catalog(folder: Path, lang: str, domain: str,
+             stamp: tuple[float, float]) -> _gettext.NullTranslations:
+    po, mo = folder / f"{domain}.po", folder / f"{domain}.mo"
     if mo.exists() and stamp[1] >= stamp[0]:
         with mo.open("rb") as fh:
             return _gettext.GNUTranslations(fh)
@@ -66,7 +73,7 @@ def _catalog(lang: str, folder: Path, stamp: tuple[float, float]) -> _gettext.Nu
     from babel.messages.pofile import read_po
 
     with po.open("rb") as fh:
-        catalog = read_po(fh, locale=lang, domain=DOMAIN)
+        catalog = read_po(fh, locale=lang, domain=domain)
     buffer = io.BytesIO()
     write_mo(buffer, catalog, use_fuzzy=False)
     buffer.seek(0)
@@ -85,9 +92,7 @@ def translations(lang: str | None = None) -> _gettext.NullTranslations:
     lang = lang or _language
     if lang == "en":
         return _gettext.NullTranslations()
-    folder = locales_dir() / lang / "LC_MESSAGES"
-    stamp = (_mtime(folder / f"{DOMAIN}.po"), _mtime(folder / f"{DOMAIN}.mo"))
-    return _catalog(lang, folder, stamp)
+    return load_catalog(locales_dir() / lang / "LC_MESSAGES", lang)
 
 
 def _(message: str) -> str:

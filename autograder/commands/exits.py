@@ -9,7 +9,11 @@ or quiz, a port in use); 3 when the autograder itself failed.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import click
+
+from autograder.i18n import ngettext
 
 
 class ProblemsFound(click.ClickException):
@@ -28,3 +32,13 @@ class GraderFault(click.ClickException):
     """The autograder failed: not the student's fault."""
 
     exit_code = 3
+
+
+def report_problems(problems: Sequence[object]) -> None:
+    """Print each problem (``file:line: message``) and end with :class:`ProblemsFound`
+    if there are any; return quietly if there are none."""
+    for problem in problems:
+        click.echo(str(problem), err=True)
+    if problems:
+        raise ProblemsFound(ngettext("{count} problem found", "{count} problems found",
+                                     len(problems)).format(count=len(problems)))

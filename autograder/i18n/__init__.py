@@ -9,7 +9,6 @@ no build step and a stale ``.mo`` never hides a translation.
 from __future__ import annotations
 
 import gettext as _gettext
-import io
 import os
 from functools import cache
 from pathlib import Path
@@ -38,22 +37,7 @@ def translations(lang: str, domain: str = DOMAIN) -> _gettext.NullTranslations:
     """Translations for ``lang`` in ``domain``; English (the source) is a null catalog."""
     if lang == "en":
         return _gettext.NullTranslations()
-    folder = locales_dir() / lang / "LC_MESSAGES"
-    po, mo = folder / f"{domain}.po", folder / f"{domain}.mo"
-    if mo.exists() and (not po.exists() or mo.stat().st_mtime >= po.stat().st_mtime):
-        with mo.open("rb") as fh:
-            return _gettext.GNUTranslations(fh)
-    if not po.exists():
-        return _gettext.NullTranslations()
-    from babel.messages.mofile import write_mo
-    from babel.messages.pofile import read_po
-
-    with po.open("rb") as fh:
-        catalog = read_po(fh, locale=lang, domain=domain)
-    buffer = io.BytesIO()
-    write_mo(buffer, catalog, use_fuzzy=False)
-    buffer.seek(0)
-    return _gettext.GNUTranslations(buffer)
+    return sim.i18n.load_catalog(locales_dir() / lang / "LC_MESSAGES", lang, domain)
 
 
 def set_language(lang: str) -> None:

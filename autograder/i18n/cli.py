@@ -11,10 +11,10 @@ from pathlib import Path
 
 import click
 
-from autograder.commands.exits import ProblemsFound, UsageProblem
+from autograder.commands.exits import UsageProblem, report_problems
 from autograder.core.course import course_root
 from autograder.core.errors import ContentError
-from autograder.i18n import LANGUAGES, _, locales_dir, ngettext
+from autograder.i18n import LANGUAGES, _, locales_dir
 from autograder.i18n.tools import check_catalog, compile_catalogs, extract, update
 
 _TARGETS = tuple(lang for lang in LANGUAGES if lang != "en")
@@ -75,9 +75,5 @@ def check_command(langs: tuple[str, ...]) -> None:
         for lang in langs:
             po = locales / lang / "LC_MESSAGES" / f"{template.stem}.po"
             problems += check_catalog(template, po, lang)
-    for p in problems:
-        click.echo(str(p), err=True)
-    if problems:
-        raise ProblemsFound(ngettext("{count} problem found", "{count} problems found",
-                                  len(problems)).format(count=len(problems)))
+    report_problems(problems)
     click.echo(_("All catalogs are complete."))

@@ -14,7 +14,7 @@ from typing import Any, TypeVar
 
 import click
 
-from autograder.commands.exits import ProblemsFound, UsageProblem
+from autograder.commands.exits import UsageProblem, report_problems
 from autograder.core.errors import ContentError
 from autograder.core.results import RunResult
 from autograder.i18n import (
@@ -23,7 +23,6 @@ from autograder.i18n import (
     get_language,
     is_rtl,
     locales_dir,
-    ngettext,
     set_language,
 )
 from autograder.i18n.tools import read_catalog
@@ -99,11 +98,7 @@ def lint_command() -> None:
     from autograder.quiz.lint import lint
 
     problems = lint()
-    for p in problems:
-        click.echo(str(p), err=True)
-    if problems:
-        raise ProblemsFound(ngettext("{count} problem found", "{count} problems found",
-                                  len(problems)).format(count=len(problems)))
+    report_problems(problems)
     click.echo(_("All quizzes are complete and translated."))
 
 
