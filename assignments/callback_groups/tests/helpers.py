@@ -186,8 +186,8 @@ def rate_reports(rates: Any, start: float, end: float) -> list[float]:
 
 def wait_student_idle(student: Any, wall_timeout: float) -> None:
     """Wait (wall time: the world is paused) until the student's process has no work."""
-    from sim.bridge import process_state
+    from sim.procstate import process_busy
 
     end = time.monotonic() + wall_timeout
-    while time.monotonic() < end and process_state(student.process.pid)[0]:
+    while time.monotonic() < end and process_busy(student.process.pid):
         time.sleep(0.002)
