@@ -33,6 +33,9 @@ from autograder.quiz.views import question_views
 
 FONT_STACK_UR = ('"Noto Nastaliq Urdu", "Jameel Noori Nastaleeq", "Urdu Typesetting", '
                  '"Noto Naskh Arabic", serif')
+# Latin runs inside Urdu (``:lang(en)``): Nastaliq fonts have digits but no Latin letters,
+# so left to the Urdu stack a run would mix a fallback serif with Nastaliq digits.
+FONT_STACK_LATIN = '"Noto Sans", "DejaVu Sans", system-ui, sans-serif'
 
 
 def _environment() -> jinja2.Environment:
@@ -40,7 +43,8 @@ def _environment() -> jinja2.Environment:
         loader=jinja2.PackageLoader("autograder", "templates"),
         autoescape=jinja2.select_autoescape(["html"], default=True),
         trim_blocks=True, lstrip_blocks=True, undefined=jinja2.StrictUndefined)
-    env.globals.update(_=_, ngettext=ngettext, font_stack_ur=Markup(FONT_STACK_UR))
+    env.globals.update(_=_, ngettext=ngettext, font_stack_ur=Markup(FONT_STACK_UR),
+                       font_stack_latin=Markup(FONT_STACK_LATIN))
     env.filters.update(rich=rich, plain=plain)
     return env
 
