@@ -2,7 +2,19 @@
 
 from __future__ import annotations
 
-from autograder.quiz.localize import LRI, PDI, Text, markdown_inline, plain, rich
+from collections.abc import Iterator
+
+import pytest
+
+from autograder.i18n import set_language
+from autograder.quiz.localize import LRI, PDI, Text, markdown_inline, plain, rich, sentence
+
+
+@pytest.fixture(autouse=True)
+def english() -> Iterator[None]:
+    set_language("en")
+    yield
+    set_language("en")
 
 
 def ur(text: str) -> Text:
@@ -33,3 +45,18 @@ def test_plain_and_markdown_isolate_the_same_runs() -> None:
     assert plain(ur("حد ±0.5 rad/s ہے")) == f"حد {LRI}±0.5 rad/s{PDI} ہے"
     md = markdown_inline(ur("اگر a < b ہو"))
     assert md == f"اگر {LRI}a{PDI} &lt; {LRI}b{PDI} ہو"  # the entity is not split
+
+
+def test_sentence_isolates_latin_runs_and_english_values() -> None:
+    template = "{world} میں روبوٹ کا راستہ (dashed line) ({count})"
+    world = Text("Empty room, 6 x 6 m", "en", fallback=True)
+    set_language("ur")
+    html = sentence(template, world=world, count=3)
+    assert html.startswith('<bdi><span lang="en" dir="ltr" class="fallback">Empty room, 6 x 6 m'
+                           "</span></bdi> میں")
+    assert '(<bdi lang="en" dir="ltr">dashed line</bdi>) (3)' in html
+    assert sentence("<b> {x}", x="<i>") == '&lt;<bdi lang="en" dir="ltr">b</bdi>&gt; &lt;i&gt;'
+    set_language("en")
+    assert sentence("<b> {x}", x="<i>") == "&lt;b&gt; &lt;i&gt;"  # escaped, both parts
+    assert sentence(template, world=world, count=3).startswith(
+        '<bdi><span lang="en" dir="ltr" class="fallback">Empty room')

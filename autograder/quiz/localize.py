@@ -167,6 +167,26 @@ def rich(text: Text) -> Markup:
     return html
 
 
+_FIELD = re.compile(r"(\{[^{}]*\})")
+
+
+def sentence(template: str, **values: object) -> Markup:
+    """A platform message as HTML (``{{ _("...")|bidi(name=value) }}`` in templates): in a
+    right-to-left language its Latin runs are isolated as in :func:`rich`; each ``{name}``
+    is filled with its value, escaped, a :class:`Text` rendered by :func:`rich` and isolated
+    in ``<bdi>`` (an English name keeps its own order inside the Urdu sentence)."""
+    filled = {k: Markup("<bdi>{}</bdi>").format(rich(v)) if isinstance(v, Text) else v
+              for k, v in values.items()}
+    if not is_rtl():
+        return escape(template).format(**filled) if values else escape(template)
+    if not values:
+        return isolate_latin(template)
+    parts = []
+    for i, piece in enumerate(_FIELD.split(template)):
+        parts.append(Markup(piece).format(**filled) if i % 2 else isolate_latin(piece))
+    return Markup("").join(parts)
+
+
 def plain(text: Text, isolate: bool | None = None) -> str:
     """Text where markup cannot go (``<title>``, ``<option>``): code and Latin runs in
     Unicode isolates when the language is right-to-left."""

@@ -24,6 +24,7 @@ from autograder.quiz.localize import (
     markdown_inline,
     plain,
     rich,
+    sentence,
     using_language,
 )
 from autograder.quiz.model import Quiz
@@ -45,7 +46,7 @@ def _environment() -> jinja2.Environment:
         trim_blocks=True, lstrip_blocks=True, undefined=jinja2.StrictUndefined)
     env.globals.update(_=_, ngettext=ngettext, font_stack_ur=Markup(FONT_STACK_UR),
                        font_stack_latin=Markup(FONT_STACK_LATIN))
-    env.filters.update(rich=rich, plain=plain)
+    env.filters.update(rich=rich, plain=plain, bidi=sentence)
     return env
 
 

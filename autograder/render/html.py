@@ -37,7 +37,10 @@ def _trajectories(result: RunResult, exercise_folder: Path | None) -> list[dict[
             continue
         if not recording.samples or recording.distance() < 0.05:
             continue  # the robot stood still: nothing to look at
-        pictures.append({"module": module, "world": spec.title or spec.name,
+        english = result.lang != "en"  # marked as English inside another language
+        pictures.append({"module": module,
+                         "world": Text(spec.title or spec.name, "en" if english else result.lang,
+                                       english),
                          "collisions": len(recording.collisions),
                          "svg": Markup(trajectory_svg(spec, recording, spec.goal))})
     return pictures
