@@ -1,13 +1,27 @@
-"""Urdu that reads in order: Latin runs isolated as English in HTML and Markdown."""
+"""Urdu that reads in order: Latin runs isolated as English in HTML and Markdown, and the
+simulator's English (collisions, world titles) translated."""
 
 from __future__ import annotations
 
+import io
+import math
 from collections.abc import Iterator
+from fractions import Fraction
+from pathlib import Path
 
 import pytest
+from babel.messages.pofile import read_po, write_po
 
-from autograder.i18n import set_language
+from autograder.core.results import RunResult, TestResult
+from autograder.i18n import set_language, translations
 from autograder.quiz.localize import LRI, PDI, Text, markdown_inline, plain, rich, sentence
+from autograder.render.html import to_html
+from sim.physics import Contact, describe
+from sim.recorder import Recording, Sample
+from sim.svg import trajectory_svg
+from sim.worldfile import extract_world, load_world, title_of
+
+REPO = Path(__file__).resolve().parent.parent
 
 
 @pytest.fixture(autouse=True)
@@ -60,3 +74,87 @@ def test_sentence_isolates_latin_runs_and_english_values() -> None:
     assert sentence("<b> {x}", x="<i>") == "&lt;b&gt; &lt;i&gt;"  # escaped, both parts
     assert sentence(template, world=world, count=3).startswith(
         '<bdi><span lang="en" dir="ltr" class="fallback">Empty room')
+
+
+def _urdu_run() -> RunResult:
+    tests = (TestResult("test_starts", "node شروع ہوتا ہے", Fraction(1), Fraction(1), "passed"),
+             TestResult("test_rate", "cmd_vel دس Hz پر رہتا ہے", Fraction(0), Fraction(2),
+                        "failed", message="Traceback (most recent call last):"))
+    return RunResult("exercise", "parameter_validation", "Parameter validation: ایک governor",
+                     tests, lang="ur")
+
+
+# The simulator's English, translated ------------------------------------------------------
+
+URDU = {  # the translations proposed for the catalog
+    ("world", "Room with obstacles"): "رکاوٹوں والا کمرہ",
+    ("world", "Empty room, 6 x 6 m"): "خالی کمرہ، 6 x 6 m",
+    (None, "wall {number}"): "دیوار {number}",
+    (None, "box {number}"): "ڈبا {number}",
+    (None, "circle {number}"): "گول رکاوٹ {number}",
+    (None, "{seconds:.2f} s: {what}"): "{seconds:.2f} s پر: {what}",
+}
+
+
+@pytest.fixture
+def urdu_catalog(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[Path]:
+    """The course's Urdu catalog with the simulator's new strings translated."""
+    with (REPO / "locales" / "ur" / "LC_MESSAGES" / "messages.po").open("rb") as fh:
+        catalog = read_po(fh, locale="ur")
+    for (context, msgid), msgstr in URDU.items():
+        catalog.add(msgid, msgstr, context=context)
+    folder = tmp_path / "locales" / "ur" / "LC_MESSAGES"
+    folder.mkdir(parents=True)
+    buffer = io.BytesIO()
+    write_po(buffer, catalog)
+    (folder / "messages.po").write_bytes(buffer.getvalue())
+    monkeypatch.setenv("AUTOGRADER_LOCALES", str(tmp_path / "locales"))
+    translations.cache_clear()
+    yield tmp_path / "locales"
+    translations.cache_clear()
+
+
+def test_world_titles_are_extracted_for_the_catalog() -> None:
+    def titles(path: Path) -> list:
+        with path.open("rb") as fh:
+            return list(extract_world(fh, {}, (), {}))
+
+    found = titles(REPO / "sim" / "worlds" / "empty_room.yaml")
+    assert found == [(2, "pgettext", ("world", "Empty room, 6 x 6 m"), ["world title"])]
+    assert titles(REPO / "assignments" / "timer_sync" / "long_hall.yaml")[0][2] == (
+        "world", "Long hall")
+    assert titles(REPO / "assignments" / "timer_sync" / "exercise.yaml") == []
+
+
+def test_collisions_and_world_titles_come_out_translated(urdu_catalog: Path) -> None:
+    spec = load_world("obstacles")
+    assert (title_of(spec), describe("wall 3")) == ("Room with obstacles", "wall 3")
+    set_language("ur")
+    assert title_of(spec) == "رکاوٹوں والا کمرہ"
+    assert describe("wall 3") == "دیوار 3" and describe("added box 7") == "added box 7"
+    assert Contact(1.0, 2.0, 3.0, "box 1").description == "ڈبا 1"
+    assert describe("?") == "?"
+    svg = trajectory_svg(spec, Recording(world="obstacles", samples=[
+        Sample(1.0, 3.0, 3.0, 0.0, 0.2, 0.0)], collisions=[Contact(1.0, 4.2, 3.0, "box 0")]))
+    assert "<title>رکاوٹوں والا کمرہ</title>" in svg and "1.00 s پر: ڈبا 0" in svg
+
+
+def test_urdu_report_has_no_english_collisions_or_world_names(urdu_catalog: Path) -> None:
+    samples = [Sample(t=i * 0.1, x=3 + 0.05 * i, y=3 + math.sin(i / 10) / 5, theta=0.0, v=0.5,
+                      w=0.0) for i in range(30)]
+    hits = [Contact(1.2, 4.2, 3.0, "box 0"), Contact(2.0, 4.4, 3.1, "box 1"),
+            Contact(2.9, 5.9, 3.0, "wall 3"), Contact(3.0, 1.2, 2.6, "circle 2")]
+    run = _urdu_run()
+    recordings = {
+        "test_a.py": Recording("obstacles", samples, hits).to_dict(),
+        "test_b.py": Recording("empty_room", samples, []).to_dict(),
+    }
+    page = to_html(RunResult(run.kind, run.id, run.title, run.tests, lang="ur",
+                             data={"recordings": recordings}))
+    for english in ("wall 3", "box 0", "box 1", "circle 2", "Room with obstacles",
+                    "Empty room"):
+        assert english not in page, english
+    assert page.count('<path class="collision"') == 4
+    for urdu in ("دیوار 3", "ڈبا 1", "گول رکاوٹ 2", "<title>خالی کمرہ، 6 x 6 m</title>",
+                 "<bdi>رکاوٹوں والا کمرہ</bdi> میں روبوٹ کا راستہ"):
+        assert urdu in page, urdu
