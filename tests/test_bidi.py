@@ -1,27 +1,34 @@
-"""Urdu that reads in order: Latin runs isolated as English in HTML and Markdown, and the
-simulator's English (collisions, world titles) translated."""
+"""Urdu that reads in order: Latin runs isolated as English in HTML and Markdown, marks
+for terminals, and the simulator's English (collisions, world titles) translated."""
 
 from __future__ import annotations
 
+import dataclasses
 import io
 import math
+import unicodedata
 from collections.abc import Iterator
 from fractions import Fraction
 from pathlib import Path
 
 import pytest
 from babel.messages.pofile import read_po, write_po
+from click.testing import CliRunner
 
+from autograder.cli import main
 from autograder.core.results import RunResult, TestResult
-from autograder.i18n import set_language, translations
+from autograder.i18n import get_language, set_language, translations
+from autograder.quiz.cli import quiz_cli
 from autograder.quiz.localize import LRI, PDI, Text, markdown_inline, plain, rich, sentence
 from autograder.render.html import to_html
+from autograder.render.terminal import RLM, for_terminal, rtl_notice, to_terminal
 from sim.physics import Contact, describe
 from sim.recorder import Recording, Sample
 from sim.svg import trajectory_svg
 from sim.worldfile import extract_world, load_world, title_of
 
 REPO = Path(__file__).resolve().parent.parent
+NOTICE = "Most terminals cannot lay out right-to-left text."
 
 
 @pytest.fixture(autouse=True)
@@ -76,12 +83,91 @@ def test_sentence_isolates_latin_runs_and_english_values() -> None:
         '<bdi><span lang="en" dir="ltr" class="fallback">Empty room')
 
 
+# Terminals ---------------------------------------------------------------------------------
+
+
+def test_for_terminal_marks_urdu_lines_that_start_left_to_right() -> None:
+    text = (" ✔     1/1  node شروع ہوتا ہے\nاسکور: 1/3\n[INFO] started\n"
+            "\x1b[1mtimer_sync — ایک\x1b[0m")
+    lines = for_terminal(text, "ur").split("\n")
+    assert lines[0] == RLM + " ✔     1/1  node شروع ہوتا ہے"  # a mark, then a Latin word
+    assert lines[1] == "اسکور: 1/3"  # starts right to left already
+    assert lines[2] == "[INFO] started"  # no Urdu in it: the program's own output
+    assert lines[3].startswith(RLM + "\x1b[1m")  # colour codes are not text
+    assert for_terminal(text, "en") == text
+    assert for_terminal(for_terminal(text, "ur"), "ur") == for_terminal(text, "ur")
+
+
+def test_rtl_notice_says_where_the_text_reads_laid_out() -> None:
+    assert rtl_notice("en") is None
+    assert "--html report.html" in rtl_notice("ur")
+    assert "out/report.html" in rtl_notice("ur", html=Path("out/report.html"))
+    assert "autograder quiz serve" in rtl_notice("ur", serve=True)
+
+
 def _urdu_run() -> RunResult:
     tests = (TestResult("test_starts", "node شروع ہوتا ہے", Fraction(1), Fraction(1), "passed"),
              TestResult("test_rate", "cmd_vel دس Hz پر رہتا ہے", Fraction(0), Fraction(2),
                         "failed", message="Traceback (most recent call last):"))
     return RunResult("exercise", "parameter_validation", "Parameter validation: ایک governor",
                      tests, lang="ur")
+
+
+def test_urdu_summary_lines_start_right_to_left() -> None:
+    lines = to_terminal(_urdu_run()).split("\n")
+    assert lines[0] == RLM + "parameter_validation — Parameter validation: ایک governor"
+    assert lines[2].startswith(RLM + " ✔") and lines[3].startswith(RLM + " ✘")
+    assert "\n          Traceback (most recent call last):" in to_terminal(_urdu_run())
+
+
+def test_check_in_urdu_marks_lines_and_points_to_the_report(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from autograder.core.report import RawTest
+
+    def fake_grade(exercise, submission, *, progress=None, **_kw):  # noqa: ANN001, ANN202
+        progress(RawTest("t.py::test_starts", "test_starts", "node شروع ہوتا ہے", 1,
+                         "visible", "all", True, "passed"))
+        return dataclasses.replace(_urdu_run(), lang=get_language())
+
+    monkeypatch.setattr("autograder.grading.run.grade", fake_grade)
+    starter = REPO / "assignments" / "parameter_validation" / "starter" / "velocity_governor.py"
+    report = tmp_path / "report.html"
+    result = CliRunner().invoke(main, ["check", "parameter_validation", str(starter),
+                                       "--lang", "ur", "--html", str(report)])
+    assert result.exit_code == 0, result.output
+    assert result.stderr.split("\n")[0].count(str(report)) == 1  # the notice, first
+    assert RLM + " ✔" in result.stderr  # the progress line
+    assert result.stdout.startswith(RLM + "parameter_validation — ")
+    assert report.read_text().startswith("<!doctype html>")
+    english = CliRunner().invoke(main, ["check", "parameter_validation", str(starter),
+                                        "--lang", "en"])
+    assert RLM not in english.output and NOTICE not in english.output
+
+
+def _first_strong(line: str) -> str | None:
+    return next((kind for kind in map(unicodedata.bidirectional, line)
+                 if kind in ("L", "R", "AL")), None)
+
+
+def test_quiz_score_in_urdu_marks_lines_and_writes_the_page(tmp_path: Path) -> None:
+    answers = tmp_path / "answers.json"
+    answers.write_text('{"quiz": "rclpy-part2", "answers": {"gil": "cpython-lock"}}')
+    page = tmp_path / "result.html"
+    result = CliRunner().invoke(quiz_cli, ["score", "rclpy-part2", str(answers), "--lang", "ur",
+                                           "--html", str(page)])
+    assert result.exit_code == 0, result.output
+    assert str(page) in result.stderr.split("\n")[0]
+    urdu = [line for line in result.stdout.split("\n")
+            if any(unicodedata.bidirectional(c) == "AL" for c in line)]
+    assert len(urdu) > 10
+    for line in urdu:  # each reads right to left in a terminal that lays out bidi text
+        assert _first_strong(line) != "L", line
+    assert sum(line.startswith(RLM) for line in urdu) >= 2  # "1. rclpy ...", "   node ..."
+    assert '<html lang="ur" dir="rtl">' in page.read_text()
+    assert "Take the quiz again" not in page.read_text()  # no server to take it on
+    as_json = CliRunner().invoke(quiz_cli, ["score", "rclpy-part2", str(answers), "--lang",
+                                            "ur", "--json"])
+    assert RLM not in as_json.output and as_json.output.startswith("{")
 
 
 # The simulator's English, translated ------------------------------------------------------

@@ -81,8 +81,9 @@ def render_page(quiz: Quiz, lang: str, seed: str | int | None = None,
 
 
 def render_result(quiz: Quiz, result: RunResult, answers: Mapping[str, Any],
-                  seed: str | int | None = None) -> str:
-    """The page a student sees after submitting: score, verdict, per-question feedback."""
+                  seed: str | int | None = None, retake: bool = True) -> str:
+    """The page a student sees after submitting: score, verdict, per-question feedback;
+    ``retake``: with a link to take the quiz again (served pages only)."""
     lang = result.lang
     saved = {"quiz": quiz.id, "answers": dict(answers)}
     if seed is not None:
@@ -93,7 +94,7 @@ def render_result(quiz: Quiz, result: RunResult, answers: Mapping[str, Any],
             score=format_number(result.score, lang),
             max_score=format_number(result.max_score, lang),
             percent=format_percent(result.fraction, lang),
-            feedback=_feedback(quiz, result),
+            feedback=_feedback(quiz, result), retake=retake,
             answers_json=json.dumps(saved, ensure_ascii=False, indent=2))
 
 
