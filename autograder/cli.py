@@ -118,7 +118,7 @@ def _run(exercise: str, submission: Path, hidden: bool, outputs: dict[str, Path 
     from autograder.core.results import TestResult, exact
     from autograder.core.submission import SubmissionNotFound, locate
     from autograder.grading.run import grade
-    from autograder.render.terminal import test_line, to_terminal
+    from autograder.render.terminal import for_terminal, rtl_notice, test_line, to_terminal
 
     found = _exercise(exercise)
     try:
@@ -134,8 +134,11 @@ def _run(exercise: str, submission: Path, hidden: bool, outputs: dict[str, Path 
             status=raw.status, message=raw.message, visibility=raw.visibility), color,
             reveal=False), err=True)
 
-    click.echo(_("Grading {file} for {exercise} in the simulator...").format(
-        file=submission, exercise=found.id), err=True)
+    notice = rtl_notice(html=outputs.get("html"))
+    if notice:
+        click.echo(notice, err=True)
+    click.echo(for_terminal(_("Grading {file} for {exercise} in the simulator...").format(
+        file=submission, exercise=found.id)), err=True)
     result = grade(found, submission, hidden=hidden, domain=domain, real_time_factor=rtf,
                    progress=progress)
     click.echo(to_terminal(result, color=color))

@@ -15,7 +15,7 @@ import click
 from sim.content import ContentError
 from sim.i18n import _
 from sim.pacing import DEFAULT_CLOCK_HZ
-from sim.worldfile import load_world, world_names, world_path
+from sim.worldfile import load_world, title_of, world_names, world_path
 
 
 class WorldFileError(click.ClickException):
@@ -41,7 +41,7 @@ def worlds_command() -> None:
     """List the shipped worlds."""
     for name in world_names():
         spec = _load(name)
-        click.echo(f"{name:<12} {spec.title}")
+        click.echo(f"{name:<12} {title_of(spec)}")
 
 
 @sim_cli.command("check")
@@ -49,7 +49,7 @@ def worlds_command() -> None:
 def check_command(file: Path) -> None:
     """Validate a world file; report the file, line and field of the first mistake."""
     spec = _load(str(file) if file.suffix else str(file) + ".yaml")
-    click.echo(_("{path}: ok ({title})").format(path=file, title=spec.title or spec.name))
+    click.echo(_("{path}: ok ({title})").format(path=file, title=title_of(spec)))
 
 
 @sim_cli.command("run")
@@ -129,7 +129,7 @@ def _summary(spec, bridge, effective: float) -> str:  # noqa: ANN001
         _("Distance travelled: {d:.2f} m").format(d=bridge.recording.distance()),
         _("Collisions: {n}").format(n=len(collisions)),
     ]
-    lines += [_("  at {t:.2f} s with {what}").format(t=c.t, what=c.what)
+    lines += [_("  at {t:.2f} s with {what}").format(t=c.t, what=c.description)
               for c in collisions[:10]]
     if spec.goal is not None:
         reached = math.hypot(x - spec.goal.x, y - spec.goal.y) <= spec.goal.tolerance

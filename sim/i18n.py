@@ -100,6 +100,11 @@ def _(message: str) -> str:
     return translations().gettext(message)
 
 
+def pgettext(context: str, message: str) -> str:
+    """Translate ``message`` given in ``context`` (a world's title: context ``world``)."""
+    return translations().pgettext(context, message)
+
+
 def N_(message: str) -> str:
     """Mark ``message`` for extraction without translating it yet (translated when shown)."""
     return message

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 import pymunk
 
+from sim.i18n import N_, _
 from sim.worldfile import ROBOT_RADIUS, Box, Circle, WorldSpec
 
 ROBOT_MASS = 1.0
@@ -27,6 +28,22 @@ _ROBOT = 1
 _STATIC = 2
 
 
+# What a contact names.  ``Contact.what`` is data ("wall 3"): recordings keep it as is in
+# the results, whatever the language; people are shown :func:`describe`.
+_THINGS = {"wall": N_("wall {number}"), "box": N_("box {number}"),
+           "circle": N_("circle {number}"), "added box": N_("added box {number}"),
+           "added circle": N_("added circle {number}")}
+
+
+def describe(what: str) -> str:
+    """``what`` a contact names ("wall 3", "added box 7"), in the active language."""
+    kind, _sep, number = what.rpartition(" ")
+    template = _THINGS.get(kind)
+    if template is None or not number.isdigit():
+        return what  # "?" or a label a test chose
+    return _(template).format(number=number)
+
+
 @dataclass(frozen=True)
 class Contact:
     """The robot started touching something: when, where the robot was, what it hit."""
@@ -35,6 +52,11 @@ class Contact:
     x: float
     y: float
     what: str
+
+    @property
+    def description(self) -> str:
+        """What it hit, for people, in the active language ("wall 3" in English)."""
+        return describe(self.what)
 
 
 def _approach(current: float, target: float, max_delta: float) -> float:

@@ -1,7 +1,8 @@
 """A picture of a run: the arena, walls, obstacles, the path, start, end, goal, collisions.
 
 A pure function of data returning a self-contained inline SVG (no scripts, no external
-references), so reports can embed it as is.  World y points up; SVG y points down, so
+references), so reports can embed it as is.  Its tooltips (the world's title, what each
+collision hit) are in the active language.  World y points up; SVG y points down, so
 everything is drawn inside a group that flips the y axis.
 """
 
@@ -10,9 +11,10 @@ from __future__ import annotations
 import math
 from html import escape
 
-from sim.physics import box_corners
+from sim.i18n import _
+from sim.physics import box_corners, describe
 from sim.recorder import Recording
-from sim.worldfile import ROBOT_RADIUS, Goal, WorldSpec
+from sim.worldfile import ROBOT_RADIUS, Goal, WorldSpec, title_of
 
 _PX_PER_M = 100.0
 
@@ -37,7 +39,7 @@ def trajectory_svg(spec: WorldSpec, recording: Recording, goal: Goal | None = No
         f'height="{_num((h + 2 * margin) * _PX_PER_M)}" '
         f'viewBox="{_num(-margin)} {_num(-margin)} {_num(w + 2 * margin)} '
         f'{_num(h + 2 * margin)}" role="img">',
-        f"<title>{escape(spec.title or spec.name)}</title>",
+        f"<title>{escape(title_of(spec))}</title>",
         f'<g transform="translate(0 {_num(h)}) scale(1 -1)">',
         f'<rect x="0" y="0" width="{_num(w)}" height="{_num(h)}" fill="#fafafa"/>',
     ]
@@ -66,10 +68,11 @@ def trajectory_svg(spec: WorldSpec, recording: Recording, goal: Goal | None = No
         parts.append(_robot("end", end.x, end.y, end.theta, "#1565c0"))
     for c in collisions:
         d = 0.06
+        tooltip = _("{seconds:.2f} s: {what}").format(seconds=c.t, what=describe(c.what))
         parts.append(f'<path class="collision" d="M{_num(c.x - d)},{_num(c.y - d)} '
                      f'L{_num(c.x + d)},{_num(c.y + d)} M{_num(c.x - d)},{_num(c.y + d)} '
                      f'L{_num(c.x + d)},{_num(c.y - d)}" stroke="#d32f2f" stroke-width="0.03">'
-                     f"<title>{escape(f'{c.t:.2f} s: {c.what}')}</title></path>")
+                     f"<title>{escape(tooltip)}</title></path>")
     parts.append("</g></svg>")
     return "\n".join(parts)
 

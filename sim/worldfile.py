@@ -12,14 +12,18 @@ centre and size, a goal's position, a fault's kind) is required.
 from __future__ import annotations
 
 import math
+from collections.abc import Collection, Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import IO, Any
 
 from sim.content import ContentError, Document, build, load_document
 from sim.faultkinds import KINDS, kind_names
-from sim.i18n import _
+from sim.i18n import _, pgettext
 
 WORLDS_DIR = Path(__file__).resolve().parent / "worlds"
+TITLE_CONTEXT = "world"
+"""The gettext context of world titles (``messages`` domain, see :func:`extract_world`)."""
 ROBOT_RADIUS = 0.105
 """TurtleBot3-like footprint radius (m): the robot is a disc of this size."""
 
@@ -242,3 +246,25 @@ def load_world(name_or_path: str | Path) -> WorldSpec:
 def world_names() -> list[str]:
     """Names of the shipped worlds."""
     return sorted(p.stem for p in WORLDS_DIR.glob("*.yaml"))
+
+
+def title_of(spec: WorldSpec) -> str:
+    """The world's title in the active language (its name when it has none)."""
+    return pgettext(TITLE_CONTEXT, spec.title) if spec.title else spec.name
+
+
+def extract_world(fileobj: IO[bytes], keywords: Mapping[str, Any],
+                  comment_tags: Collection[str],
+                  options: Mapping[str, Any]) -> Iterator[tuple[int, str, tuple[str, str],
+                                                            list[str]]]:
+    """Babel extractor: a world file's ``title``, context ``world``, into the ``messages``
+    catalog beside the simulator's other messages (babel.cfg names it for the shipped
+    worlds and the worlds beside each exercise).  An exercise's own ``exercise.yaml`` is
+    not a world and yields nothing."""
+    path = Path(getattr(fileobj, "name", "world.yaml"))
+    if path.name == "exercise.yaml":
+        return
+    doc = load_document(path, fileobj.read().decode("utf-8"))
+    title = doc.data.get("title") if isinstance(doc.data, dict) else None
+    if isinstance(title, str) and title.strip():
+        yield doc.line("title") or 1, "pgettext", (TITLE_CONTEXT, title), ["world title"]

@@ -89,3 +89,22 @@ def ink(page: Any, png: bytes, box: tuple[int, int, int, int] | None = None) -> 
     data = base64.b64encode(png).decode()
     page.goto("about:blank")
     return page.evaluate(_INK_JS, [data, list(box) if box else None])
+
+
+def fonts_used(page: Any, selector: str) -> list[dict[str, int]]:
+    """For each element ``selector`` finds, the fonts Chromium drew its text with
+    ({family: glyphs}), as its DevTools report them: what fell back to which font, which
+    computed styles cannot tell."""
+    cdp = page.context.new_cdp_session(page)
+    try:
+        cdp.send("DOM.enable")
+        cdp.send("CSS.enable")
+        root = cdp.send("DOM.getDocument", {"depth": -1})["root"]["nodeId"]
+        nodes = cdp.send("DOM.querySelectorAll", {"nodeId": root, "selector": selector})
+        found = []
+        for node in nodes["nodeIds"]:
+            fonts = cdp.send("CSS.getPlatformFontsForNode", {"nodeId": node})["fonts"]
+            found.append({f["familyName"]: f["glyphCount"] for f in fonts})
+        return found
+    finally:
+        cdp.detach()

@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from browser import chromium_page, ink
+from browser import chromium_page, fonts_used, ink
 
 from autograder.quiz.catalog import load_all
 from autograder.quiz.model import Question, Quiz, load_quiz
@@ -106,6 +106,65 @@ def test_urdu_page_renders_rtl_in_nastaliq_unclipped(tmp_path: Path) -> None:
     # Not blank, and the title's ink hugs the right side of the page.
     assert stats["ink"] > 20_000
     assert title_ink["right"] > 900 * 0.85 and title_ink["left"] > 900 * 0.2
+
+
+_APART_JS = """
+(id) => {
+  // The question's number ("5.") and the digits its text begins with ("50 Hz ...").
+  const text = document.getElementById(id), number = text.querySelector(".number");
+  const walker = document.createTreeWalker(text, NodeFilter.SHOW_TEXT);
+  let node;
+  while ((node = walker.nextNode()) && (number.contains(node) || !/\\d/.test(node.data))) {}
+  const at = node.data.search(/\\d/), range = document.createRange();
+  range.setStart(node, at); range.setEnd(node, at + node.data.slice(at).match(/\\d+/)[0].length);
+  const n = number.getBoundingClientRect(), d = range.getBoundingClientRect();
+  const holder = node.parentElement;
+  return {number: [n.left, n.right, n.top, n.bottom], digits: [d.left, d.right, d.top, d.bottom],
+          numberBidi: getComputedStyle(number).unicodeBidi,
+          holder: holder.tagName, holderLang: holder.lang,
+          holderBidi: getComputedStyle(holder).unicodeBidi};
+}
+"""
+
+
+def test_question_beginning_with_a_number_keeps_its_number_apart(tmp_path: Path) -> None:
+    # "50 Hz اور 10 Hz ..." numbered 5 once read "5.50 Hz": the bidi algorithm joined the
+    # number's "5." and the text's "50" into one left-to-right number.
+    quiz = load_quiz(REPO / "quizzes" / "timer-synchronization.yaml").quiz
+    html = tmp_path / "timer-synchronization.ur.html"
+    html.write_text(render_page(quiz, "ur", seed=7), encoding="utf-8")
+    with chromium_page() as page:
+        page.goto(html.as_uri())
+        page.evaluate("document.fonts.ready")
+        found = page.evaluate(_APART_JS, "q-keep-in-step-text")
+        page.locator("#q-keep-in-step-text").screenshot(path=str(tmp_path / "q5-ur.png"))
+    assert found["numberBidi"] == "isolate"
+    assert (found["holder"], found["holderLang"], found["holderBidi"]) == ("BDI", "en", "isolate")
+    (n_left, _, n_top, n_bottom), (_, d_right, d_top, d_bottom) = (
+        found["number"], found["digits"])
+    assert d_top < n_bottom and n_top < d_bottom, found  # on the same line
+    # Right to left, the number comes first: on the right, with a gap before "50".
+    assert n_left - d_right >= 3, found
+
+
+def test_latin_runs_in_urdu_are_english_in_a_latin_face(tmp_path: Path) -> None:
+    quiz = load_quiz(REPO / "quizzes" / "timer-synchronization.yaml").quiz
+    html = tmp_path / "timer-synchronization.ur.html"
+    html.write_text(render_page(quiz, "ur", seed=7), encoding="utf-8")
+    with chromium_page() as page:
+        page.goto(html.as_uri())
+        page.evaluate("document.fonts.ready")
+        family = page.evaluate(
+            "getComputedStyle(document.querySelector('.question bdi:lang(en)')).fontFamily")
+        runs = fonts_used(page, ".question bdi")
+        unmarked = page.evaluate("document.querySelectorAll('.question bdi:not([lang])')"
+                                 ".length")
+    assert family.startswith('"Noto Sans"'), family
+    assert len(runs) > 20 and unmarked == 0
+    # Letters and digits of every run ("50 Hz", "timer callback") from one Latin font: no
+    # serif fallback for the letters, no Nastaliq for the digits.
+    for fonts in runs:
+        assert set(fonts) == {"Noto Sans"}, fonts
 
 
 def _enter_key(page: Any, question: Question) -> None:

@@ -62,7 +62,7 @@ def test_urdu_page_is_rtl_with_lang_on_the_root(urdu_page: str) -> None:
     assert "line-height: 2.6" in urdu_page
     assert "پاسنگ اسکور: 70% (4/5 سوالات)" in urdu_page
     assert "rclpy میں" not in urdu_page  # Latin runs are isolated, not bare
-    assert '<bdi dir="ltr">rclpy</bdi> میں' in urdu_page
+    assert '<bdi lang="en" dir="ltr">rclpy</bdi> میں' in urdu_page
 
 
 def test_code_stays_ltr_in_urdu(urdu_page: str) -> None:

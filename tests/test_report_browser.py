@@ -4,11 +4,12 @@ to look at: a fixed path in /tmp would belong to whichever user ran the tests fi
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from fractions import Fraction
 from pathlib import Path
 
-from browser import chromium_page, ink
+from browser import chromium_page, fonts_used, ink
 
 from autograder.core.results import RunResult, TestResult
 from autograder.render.html import to_html
@@ -78,3 +79,44 @@ def test_urdu_report_renders_rtl_in_nastaliq_unclipped(tmp_path: Path) -> None:
         assert item["overflow"] <= 0, item
     assert stats["ink"] > 10_000
     assert title_ink["right"] > 900 * 0.85  # the title starts on the right
+
+
+_CAPTION_JS = """
+() => {
+  const caption = [...document.querySelectorAll("figcaption")].at(-1);  // the robot's path
+  const world = caption.querySelector('[lang="en"]');
+  const whole = document.createRange(); whole.selectNodeContents(caption);
+  const c = whole.getBoundingClientRect(), w = world.getBoundingClientRect();
+  const style = getComputedStyle(caption);
+  return {direction: style.direction, align: style.textAlign,
+          world: world.textContent, worldBidi: getComputedStyle(world).unicodeBidi,
+          worldDirection: getComputedStyle(world).direction,
+          textRight: c.right, textLeft: c.left, worldRight: w.right, worldLeft: w.left,
+          chartFont: getComputedStyle(document.querySelector("svg.chart text")).fontFamily};
+}
+"""
+
+
+def test_urdu_report_captions_read_right_to_left(tmp_path: Path) -> None:
+    # A world beside the exercise whose title no catalog translates stays English: an
+    # isolate inside the right-to-left caption, read first, so it stands on the right.
+    (tmp_path / "practice_yard.yaml").write_text(
+        "title: Practice yard, 6 x 6 m\nsize: [6.0, 6.0]\n", encoding="utf-8")
+    result = urdu_result()
+    recorded = {**result.data["recordings"]["test_world.py"], "world": "practice_yard"}
+    result = dataclasses.replace(result, data={"recordings": {"test_world.py": recorded}})
+    page_file = tmp_path / "report.ur.html"
+    page_file.write_text(to_html(result, tmp_path), encoding="utf-8")
+    with chromium_page() as page:
+        page.goto(page_file.as_uri())
+        page.evaluate("document.fonts.ready")
+        found = page.evaluate(_CAPTION_JS)
+        page.locator("figcaption").last.screenshot(path=str(tmp_path / "caption-ur.png"))
+        runs = fonts_used(page, "bdi[lang=en], figcaption [lang=en]")
+    assert (found["direction"], found["align"]) == ("rtl", "start"), found
+    assert found["world"] == "Practice yard, 6 x 6 m"
+    assert (found["worldBidi"], found["worldDirection"]) == ("isolate", "ltr")
+    assert abs(found["worldRight"] - found["textRight"]) < 2, found
+    assert found["worldLeft"] - found["textLeft"] > 100, found
+    assert found["chartFont"].startswith('"Noto Sans"')
+    assert runs and all(set(fonts) == {"Noto Sans"} for fonts in runs), runs

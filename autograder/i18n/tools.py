@@ -25,7 +25,8 @@ from autograder.i18n import _
 
 PLATFORM_DOMAIN = "messages"
 CONTENT_DOMAIN = "content"
-PLATFORM_METHODS = frozenset({"python", "jinja2", "autograder.i18n.label_extract:extract_tests"})
+PLATFORM_METHODS = frozenset({"python", "jinja2", "autograder.i18n.label_extract:extract_tests",
+                              "sim.worldfile:extract_world"})
 KEYWORDS = {**DEFAULT_KEYWORDS, "N_": None}
 COMMENT_TAGS = ("TRANSLATORS:",)
 PROJECT = "rclpy-autograder"

@@ -21,7 +21,6 @@ from autograder.i18n import (
     LANGUAGES,
     _,
     get_language,
-    is_rtl,
     locales_dir,
     set_language,
 )
@@ -30,11 +29,12 @@ from autograder.quiz import CONTENT_DOMAIN
 from autograder.quiz.catalog import find_quiz, list_quizzes, load_all
 from autograder.quiz.localize import Localizer, format_number, format_percent, terminal
 from autograder.quiz.model import Quiz
-from autograder.quiz.render import render_markdown, render_page
+from autograder.quiz.render import render_markdown, render_page, render_result
 from autograder.quiz.scoring import key_answers, pass_summary, read_answers, result_dict, score
 from autograder.quiz.types import question_type
 from autograder.quiz.types.base import QuestionType
 from autograder.quiz.views import QuestionView, question_views
+from autograder.render.terminal import for_terminal, rtl_notice
 
 F = TypeVar("F", bound=Callable[..., Any])
 
@@ -145,7 +145,7 @@ def _summary(quiz: Quiz, result: RunResult) -> str:
         verdict=verdict, score=format_number(result.score, lang),
         max_score=format_number(result.max_score, lang),
         percent=format_percent(result.fraction, lang)), pass_summary(quiz, lang)]
-    return "\n".join(lines)
+    return for_terminal("\n".join(lines), lang)
 
 
 @quiz_cli.command("score")
@@ -154,19 +154,31 @@ def _summary(quiz: Quiz, result: RunResult) -> str:
 @_lang_option
 @click.option("--results", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="Also write the results JSON here.")
+@click.option("--html", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="Also write the result page (score, verdict, feedback) here.")
 @click.option("--json", "as_json", is_flag=True, help="Print the results JSON.")
 @_errors
 def score_command(quiz: str, answers: Path, lang: str | None, results: Path | None,
-                  as_json: bool) -> None:
+                  html: Path | None, as_json: bool) -> None:
     """Score a student's ANSWERS file for QUIZ (exit 0 whatever the score)."""
     lang = _use_lang(lang)
     qf = find_quiz(quiz)
-    result = score(qf.quiz, read_answers(answers, qf.quiz), lang)
+    given = read_answers(answers, qf.quiz)
+    result = score(qf.quiz, given, lang)
     data = json.dumps(result_dict(result), ensure_ascii=False, indent=2)
     if results:
         results.parent.mkdir(parents=True, exist_ok=True)
         results.write_text(data + "\n", encoding="utf-8")
-    click.echo(data if as_json else _summary(qf.quiz, result))
+    if html:
+        html.parent.mkdir(parents=True, exist_ok=True)
+        html.write_text(render_result(qf.quiz, result, given, retake=False), encoding="utf-8")
+    if as_json:
+        click.echo(data)
+        return
+    notice = rtl_notice(lang, html=html)
+    if notice:
+        click.echo(notice, err=True)
+    click.echo(_summary(qf.quiz, result))
 
 
 @quiz_cli.command("key")
@@ -204,20 +216,20 @@ def take_command(quiz: str, lang: str | None, seed: str | None, save: Path | Non
     qf = find_quiz(quiz)
     seed = seed if seed is not None else str(secrets.randbelow(10**9))
     loc = Localizer(qf.quiz, lang)
-    click.echo(terminal(loc.quiz_text("title")))
-    click.echo(pass_summary(qf.quiz, lang))
-    if is_rtl(lang):
-        click.echo(_("Most terminals cannot lay out right-to-left text. For the laid-out page "
-                     "run: autograder quiz serve"))
+    click.echo(for_terminal(terminal(loc.quiz_text("title"))))
+    click.echo(for_terminal(pass_summary(qf.quiz, lang)))
+    notice = rtl_notice(lang, serve=True)
+    if notice:
+        click.echo(notice)
     answers: dict[str, Any] = {}
     for view in question_views(qf.quiz, lang, seed):
         click.echo("")
-        click.echo(f"{view.number}. {terminal(view.text)}")
+        click.echo(for_terminal(f"{view.number}. {terminal(view.text)}"))
         if view.code:
             click.echo("\n".join("    " + line for line in view.code.splitlines()))
         kind = question_type(view.type)
         for line in kind.terminal_lines(view):
-            click.echo(line)
+            click.echo(for_terminal(line))
         value = _ask(kind, view)
         if value is not None:
             answers[view.id] = value

@@ -11,7 +11,7 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import re
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from decimal import Decimal
 from fractions import Fraction
 
@@ -23,9 +23,15 @@ from autograder.quiz import CONTENT_DOMAIN
 from autograder.quiz.model import Option, Question, Quiz, context, is_code_only
 
 CODE_SPAN = re.compile(r"`([^`]+)`")
-# A run of Latin-script words (identifiers, English terms) inside right-to-left text.
-_WORD = r"[\w./+=-]*(?:\(\))?"
-LATIN_RUN = re.compile(rf"[A-Za-z_]{_WORD}(?: [A-Za-z0-9_]{_WORD})*", re.ASCII)
+# A run of Latin script inside right-to-left text: identifiers, English terms, numbers with
+# their units ("50 Hz", "±0.5 rad/s", "default 0.5"), words joined by single spaces.  A
+# sign that leads a word (±, +, -, −) belongs to the run: left outside the isolate, the
+# bidi algorithm would place it on the wrong side.
+_WORD = r"[±∓+\u2212-]?[A-Za-z0-9_][\w./+=±°-]*(?:\(\))?"
+LATIN_RUN = re.compile(rf"{_WORD}(?: {_WORD})*", re.ASCII)
+# A bare number (digits and separators: 0.25, 4/5, 1,000): Urdu text holds those as they
+# are, in its own digits' face.
+BARE_NUMBER = re.compile(r"[\d.,/:]+", re.ASCII)
 FSI, LRI, PDI = "\u2068", "\u2066", "\u2069"
 
 
@@ -98,8 +104,41 @@ def format_percent(value: Fraction, lang: str) -> str:
                                   decimal_quantization=False)
 
 
-def _latin_runs(text: str, wrap: str, end: str) -> str:
-    return LATIN_RUN.sub(lambda m: f"{wrap}{m.group(0)}{end}", text)
+def _is_latin(run: str) -> bool:
+    """A Latin run to isolate: anything the pattern finds but a bare number."""
+    return BARE_NUMBER.fullmatch(run) is None
+
+
+def _latin_runs(text: str, wrap: str, end: str, quote: Callable[[str], str] = str) -> str:
+    """``text`` with each Latin run between ``wrap`` and ``end``, every piece passed through
+    ``quote`` (an escape applied after the match could break an entity like ``&lt;``)."""
+    parts, at = [], 0
+    for m in LATIN_RUN.finditer(text):
+        if _is_latin(m.group(0)):
+            parts += [quote(text[at:m.start()]), wrap, quote(m.group(0)), end]
+            at = m.end()
+    parts.append(quote(text[at:]))
+    return "".join(parts)
+
+
+def isolate_latin(text: str, lead: bool = False) -> Markup:
+    """Escaped right-to-left text with each Latin run in ``<bdi lang="en" dir="ltr">`` (its
+    own font stack comes from the page's ``:lang(en)`` rule).  With ``lead``, a bare number
+    that begins the text is isolated too, so that what stands before it (a question's
+    number, "5.") cannot run into it ("5.50")."""
+    parts, at = [], 0
+    for m in LATIN_RUN.finditer(text):
+        run = m.group(0)
+        if _is_latin(run):
+            tag = Markup('<bdi lang="en" dir="ltr">{}</bdi>')
+        elif lead and m.start() == 0:
+            tag = Markup('<bdi dir="ltr">{}</bdi>')
+        else:
+            continue
+        parts += [escape(text[at:m.start()]), tag.format(run)]
+        at = m.end()
+    parts.append(escape(text[at:]))
+    return Markup("").join(parts)
 
 
 def _paragraphs(text: str) -> str:
@@ -108,7 +147,8 @@ def _paragraphs(text: str) -> str:
 
 def rich(text: Text) -> Markup:
     """HTML for a string: `code` becomes ``<code dir="ltr">``; in right-to-left text, Latin
-    runs are isolated in ``<bdi>``; an English fallback is marked ``lang="en" dir="ltr"``."""
+    runs are isolated in ``<bdi lang="en">`` and so is a number that begins the text; an
+    English fallback is marked ``lang="en" dir="ltr"``."""
     parts = []
     for i, piece in enumerate(CODE_SPAN.split(_paragraphs(text.value))):
         if i % 2:
@@ -118,18 +158,33 @@ def rich(text: Text) -> Markup:
             if j % 2:
                 parts.append(Markup("<br><br>"))
             elif text.rtl:
-                runs = LATIN_RUN.split(chunk)
-                found = LATIN_RUN.findall(chunk)
-                for k, run in enumerate(runs):
-                    parts.append(escape(run))
-                    if k < len(found):
-                        parts.append(Markup('<bdi dir="ltr">{}</bdi>').format(found[k]))
+                parts.append(isolate_latin(chunk, lead=not parts))
             else:
                 parts.append(escape(chunk))
     html = Markup("").join(parts)
     if text.fallback:
         return Markup('<span lang="en" dir="ltr" class="fallback">{}</span>').format(html)
     return html
+
+
+_FIELD = re.compile(r"(\{[^{}]*\})")
+
+
+def sentence(template: str, **values: object) -> Markup:
+    """A platform message as HTML (``{{ _("...")|bidi(name=value) }}`` in templates): in a
+    right-to-left language its Latin runs are isolated as in :func:`rich`; each ``{name}``
+    is filled with its value, escaped, a :class:`Text` rendered by :func:`rich` and isolated
+    in ``<bdi>`` (an English name keeps its own order inside the Urdu sentence)."""
+    filled = {k: Markup("<bdi>{}</bdi>").format(rich(v)) if isinstance(v, Text) else v
+              for k, v in values.items()}
+    if not is_rtl():
+        return escape(template).format(**filled) if values else escape(template)
+    if not values:
+        return isolate_latin(template)
+    parts = []
+    for i, piece in enumerate(_FIELD.split(template)):
+        parts.append(Markup(piece).format(**filled) if i % 2 else isolate_latin(piece))
+    return Markup("").join(parts)
 
 
 def plain(text: Text, isolate: bool | None = None) -> str:
@@ -156,6 +211,10 @@ def terminal(text: Text) -> str:
 _MDX_ESCAPES = {"{": "\\{", "}": "\\}", "<": "&lt;", ">": "&gt;", "*": "\\*", "#": "\\#"}
 
 
+def _mdx_escape(text: str) -> str:
+    return "".join(_MDX_ESCAPES.get(c, c) for c in text)
+
+
 def markdown_inline(text: Text) -> str:
     """Markdown/MDX for a string: code spans kept; in RTL text, code and Latin runs wrapped
     in Unicode isolates (markup cannot go inside every Markdown construct)."""
@@ -166,9 +225,7 @@ def markdown_inline(text: Text) -> str:
         if i % 2:
             out.append(f"{LRI}`{piece}`{PDI}" if rtl else f"`{piece}`")
             continue
-        escaped = "".join(_MDX_ESCAPES.get(c, c) for c in piece)
-        out.append(LATIN_RUN.sub(lambda m: f"{LRI}{m.group(0)}{PDI}", escaped) if rtl
-                   else escaped)
+        out.append(_latin_runs(piece, LRI, PDI, _mdx_escape) if rtl else _mdx_escape(piece))
     md = "".join(out)
     if text.fallback:
         return f'<span lang="en" dir="ltr">{md}</span>'

@@ -24,6 +24,7 @@ from autograder.quiz.localize import (
     markdown_inline,
     plain,
     rich,
+    sentence,
     using_language,
 )
 from autograder.quiz.model import Quiz
@@ -33,6 +34,9 @@ from autograder.quiz.views import question_views
 
 FONT_STACK_UR = ('"Noto Nastaliq Urdu", "Jameel Noori Nastaleeq", "Urdu Typesetting", '
                  '"Noto Naskh Arabic", serif')
+# Latin runs inside Urdu (``:lang(en)``): Nastaliq fonts have digits but no Latin letters,
+# so left to the Urdu stack a run would mix a fallback serif with Nastaliq digits.
+FONT_STACK_LATIN = '"Noto Sans", "DejaVu Sans", system-ui, sans-serif'
 
 
 def _environment() -> jinja2.Environment:
@@ -40,8 +44,9 @@ def _environment() -> jinja2.Environment:
         loader=jinja2.PackageLoader("autograder", "templates"),
         autoescape=jinja2.select_autoescape(["html"], default=True),
         trim_blocks=True, lstrip_blocks=True, undefined=jinja2.StrictUndefined)
-    env.globals.update(_=_, ngettext=ngettext, font_stack_ur=Markup(FONT_STACK_UR))
-    env.filters.update(rich=rich, plain=plain)
+    env.globals.update(_=_, ngettext=ngettext, font_stack_ur=Markup(FONT_STACK_UR),
+                       font_stack_latin=Markup(FONT_STACK_LATIN))
+    env.filters.update(rich=rich, plain=plain, bidi=sentence)
     return env
 
 
@@ -76,8 +81,9 @@ def render_page(quiz: Quiz, lang: str, seed: str | int | None = None,
 
 
 def render_result(quiz: Quiz, result: RunResult, answers: Mapping[str, Any],
-                  seed: str | int | None = None) -> str:
-    """The page a student sees after submitting: score, verdict, per-question feedback."""
+                  seed: str | int | None = None, retake: bool = True) -> str:
+    """The page a student sees after submitting: score, verdict, per-question feedback;
+    ``retake``: with a link to take the quiz again (served pages only)."""
     lang = result.lang
     saved = {"quiz": quiz.id, "answers": dict(answers)}
     if seed is not None:
@@ -88,7 +94,7 @@ def render_result(quiz: Quiz, result: RunResult, answers: Mapping[str, Any],
             score=format_number(result.score, lang),
             max_score=format_number(result.max_score, lang),
             percent=format_percent(result.fraction, lang),
-            feedback=_feedback(quiz, result),
+            feedback=_feedback(quiz, result), retake=retake,
             answers_json=json.dumps(saved, ensure_ascii=False, indent=2))
 
 

@@ -25,7 +25,7 @@ from autograder.render.charts import intervals_svg
 def _trajectories(result: RunResult, exercise_folder: Path | None) -> list[dict[str, Any]]:
     from sim.recorder import Recording
     from sim.svg import trajectory_svg
-    from sim.worldfile import load_world
+    from sim.worldfile import load_world, title_of
 
     pictures = []
     for module, recorded in result.data.get("recordings", {}).items():
@@ -37,7 +37,10 @@ def _trajectories(result: RunResult, exercise_folder: Path | None) -> list[dict[
             continue
         if not recording.samples or recording.distance() < 0.05:
             continue  # the robot stood still: nothing to look at
-        pictures.append({"module": module, "world": spec.title or spec.name,
+        title = title_of(spec)  # in English when not translated: marked so
+        english = result.lang != "en" and title in (spec.title, spec.name)
+        pictures.append({"module": module,
+                         "world": Text(title, "en" if english else result.lang, english),
                          "collisions": len(recording.collisions),
                          "svg": Markup(trajectory_svg(spec, recording, spec.goal))})
     return pictures

@@ -1,11 +1,73 @@
-"""The terminal summary: a line per test with a mark, points and a one-line reason."""
+"""The terminal summary: a line per test with a mark, points and a one-line reason.
+
+Also what every command printing a right-to-left language needs (:func:`for_terminal`,
+:func:`rtl_notice`): a terminal that lays out bidi text takes each line's direction from
+its first strong character, so an Urdu line that starts with a Latin word (or a mark, then
+an English identifier) is laid out left to right and scrambled; most terminals lay out
+nothing and show the characters in memory order.  Each such line starts with a
+RIGHT-TO-LEFT MARK, and the command says once where the text reads laid out.
+"""
 
 from __future__ import annotations
+
+import re
+import unicodedata
+from pathlib import Path
 
 from babel.numbers import format_percent
 
 from autograder.core.results import RunResult, TestResult, as_decimal, number
-from autograder.i18n import _
+from autograder.i18n import _, get_language, is_rtl
+
+RLM = "\u200f"
+_ANSI = re.compile(r"\x1b\[[0-9;]*[A-Za-z]")
+
+
+def _first_strong(line: str) -> str | None:
+    """``"L"`` or ``"R"``: the bidi class of the line's first strong character, if any."""
+    for char in _ANSI.sub("", line):
+        kind = unicodedata.bidirectional(char)
+        if kind == "L":
+            return "L"
+        if kind in ("R", "AL"):
+            return "R"
+    return None
+
+
+def for_terminal(text: str, lang: str | None = None) -> str:
+    """``text`` for a terminal in ``lang`` (default: the active language).  In a
+    right-to-left language, a line holding right-to-left text whose first strong character
+    is left to right starts with U+200F RIGHT-TO-LEFT MARK; lines wholly in Latin script
+    (a program's output, a path) are left as they are.  Idempotent."""
+    if not is_rtl(lang or get_language()):
+        return text
+    lines = text.split("\n")
+    for i, line in enumerate(lines):
+        if _first_strong(line) == "L" and any(
+                unicodedata.bidirectional(c) in ("R", "AL") for c in line):
+            lines[i] = RLM + line
+    return "\n".join(lines)
+
+
+def rtl_notice(lang: str | None = None, html: Path | None = None,
+               serve: bool = False) -> str | None:
+    """What a command printing a right-to-left language says once, first: that terminals
+    cannot lay it out, and where it reads laid out (``html``: the report it writes;
+    ``serve``: the quiz server; else: how to ask for a report).  None in other languages."""
+    lang = lang or get_language()
+    if not is_rtl(lang):
+        return None
+    if serve:
+        text = _("Most terminals cannot lay out right-to-left text. For the laid-out page "
+                 "run: autograder quiz serve")
+    elif html is not None:
+        text = _("Most terminals cannot lay out right-to-left text. The laid-out report is "
+                 "in {path}: open it in a browser.").format(path=html)
+    else:
+        text = _("Most terminals cannot lay out right-to-left text. For a laid-out report, "
+                 "run the command again with --html report.html and open that file in a "
+                 "browser.")
+    return for_terminal(text, lang)
 
 _MARKS = {"passed": ("✔", "green"), "failed": ("✘", "red"), "error": ("!", "yellow"),
           "skipped": ("-", "yellow")}
@@ -26,7 +88,7 @@ def test_line(test: TestResult, color: bool = False, reveal: bool = True) -> str
     if test.status != "passed" and reveal and test.message:
         first = test.message.strip().splitlines()[0]
         line += "\n" + " " * 10 + _style(first, None, color)
-    return line
+    return for_terminal(line)
 
 
 def _bound(kind: str | None, cgroup: str | None, controller: str, rlimit: str) -> str:
@@ -80,4 +142,4 @@ def to_terminal(result: RunResult, color: bool = False, show_details: bool = Tru
             lines += ["", _style(f"✘ {test.label}", "red", color, bold=True), test.message]
             if test.hint:
                 lines.append(_("Hint: {hint}").format(hint=test.hint))
-    return "\n".join(lines)
+    return for_terminal("\n".join(lines), result.lang)

@@ -117,7 +117,7 @@ def judge_reached(mission: Mission, credit: Any, world_name: str) -> None:
         hit = mission.hit
         message = _("In the {world}, the robot hit {what} at ({x:.2f}, {y:.2f}) after "
                     "{seconds:.1f} s, having covered {share:.0%} of the way to the goal.").format(
-            world=world_name, what=hit.what, x=hit.x, y=hit.y,
+            world=world_name, what=hit.description, x=hit.x, y=hit.y,
             seconds=hit.t - mission.t0, share=progress)
         hint = _("Steer by the lidar: never drive toward a direction whose readings are "
                  "closer than the robot needs to pass.")

@@ -147,7 +147,8 @@ def test_never_collides(run, world, student):
         first = collisions[0]
         raise StudentFailure(
             _("The robot hit {what} at ({x:.2f}, {y:.2f}), {seconds:.1f} s into the run.")
-            .format(what=first.what, x=first.x, y=first.y, seconds=first.t - run.start),
+            .format(what=first.description, x=first.x, y=first.y,
+                    seconds=first.t - run.start),
             _("Stop going forward when the nearest valid reading within ±30° of ahead is "
               "0.6 m or nearer; do not let invalid readings hide an obstacle."))
 
