@@ -22,6 +22,7 @@ from sim.content import Document
 
 if TYPE_CHECKING:  # the exports build on the types: imported only for annotations
     from autograder.quiz.export.moodle import MoodleWriter
+    from autograder.quiz.export.qti import QtiItem, QtiWriter
     from autograder.quiz.export.xml import El
 
 Where = tuple[str | int, ...]
@@ -181,6 +182,11 @@ class QuestionType(abc.ABC):
         ``truefalse``, ``numerical``, ``ordering``; ``note`` for a scoring Moodle cannot
         match).  A type without one stops the export with a message naming the question."""
         raise moodle.unsupported(q)
+
+    def qti_item(self, q: Question, qti: QtiWriter) -> QtiItem:
+        """The question as a QTI 2.1 item, made with ``qti``'s builders (``choice``,
+        ``order``, ``numeric``).  A type without one stops the export, as above."""
+        raise qti.unsupported(q)
 
 
 # Shared by the types whose answer names options --------------------------------------------

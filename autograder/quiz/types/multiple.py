@@ -26,6 +26,7 @@ from sim.content import Document
 
 if TYPE_CHECKING:
     from autograder.quiz.export.moodle import MoodleWriter
+    from autograder.quiz.export.qti import QtiItem, QtiWriter
     from autograder.quiz.export.xml import El
 
 
@@ -83,3 +84,9 @@ class MultipleChoice(QuestionType):
             "options picked with no wrong one earn that share of its marks.").format(
                 number=number, id=q.id))
         return moodle.multichoice(q, self._shares(q, Fraction(-1)), single=False)
+
+    def qti_item(self, q: Question, qti: QtiWriter) -> QtiItem:
+        if q.partial_credit:  # map_response, kept within 0..1 as the platform floors at 0
+            return qti.choice(q, q.answer, max_choices=0,
+                              mapping=self._shares(q, -Fraction(1, len(q.answer))))
+        return qti.choice(q, q.answer, max_choices=0)  # match_correct: the exact set

@@ -20,6 +20,7 @@ from sim.content import Document
 
 if TYPE_CHECKING:
     from autograder.quiz.export.moodle import MoodleWriter
+    from autograder.quiz.export.qti import QtiItem, QtiWriter
     from autograder.quiz.export.xml import El
 
 # Urdu and Arabic-Indic digits and decimal separator, as a phone keyboard types them.
@@ -80,3 +81,6 @@ class Numeric(QuestionType):
 
     def moodle_question(self, q: Question, moodle: MoodleWriter) -> El:
         return moodle.numerical(q, q.answer, q.tolerance, q.unit)
+
+    def qti_item(self, q: Question, qti: QtiWriter) -> QtiItem:
+        return qti.numeric(q, q.answer, q.tolerance, q.unit)

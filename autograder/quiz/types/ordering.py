@@ -27,6 +27,7 @@ from sim.content import Document
 
 if TYPE_CHECKING:
     from autograder.quiz.export.moodle import MoodleWriter
+    from autograder.quiz.export.qti import QtiItem, QtiWriter
     from autograder.quiz.export.xml import El
 
 
@@ -84,3 +85,6 @@ class Ordering(QuestionType):
 
     def moodle_question(self, q: Question, moodle: MoodleWriter) -> El:
         return moodle.ordering(q, q.answer)
+
+    def qti_item(self, q: Question, qti: QtiWriter) -> QtiItem:
+        return qti.order(q, q.answer)

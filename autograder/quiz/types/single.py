@@ -22,6 +22,7 @@ from sim.content import Document
 
 if TYPE_CHECKING:
     from autograder.quiz.export.moodle import MoodleWriter
+    from autograder.quiz.export.qti import QtiItem, QtiWriter
     from autograder.quiz.export.xml import El
 
 
@@ -57,3 +58,6 @@ class SingleChoice(QuestionType):
     def moodle_question(self, q: Question, moodle: MoodleWriter) -> El:
         return moodle.multichoice(q, {o.id: Fraction(o.id == q.answer) for o in q.options},
                                   single=True)
+
+    def qti_item(self, q: Question, qti: QtiWriter) -> QtiItem:
+        return qti.choice(q, [q.answer], max_choices=1)

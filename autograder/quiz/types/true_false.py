@@ -21,6 +21,7 @@ from sim.content import Document
 
 if TYPE_CHECKING:
     from autograder.quiz.export.moodle import MoodleWriter
+    from autograder.quiz.export.qti import QtiItem, QtiWriter
     from autograder.quiz.export.xml import El
 
 IDS = ("true", "false")
@@ -57,3 +58,7 @@ class TrueFalse(SingleChoice):
 
     def moodle_question(self, q: Question, moodle: MoodleWriter) -> El:
         return moodle.truefalse(q, q.answer)
+
+    def qti_item(self, q: Question, qti: QtiWriter) -> QtiItem:
+        # Two choices, True then False as the page shows them, never shuffled.
+        return qti.choice(q, [self.key(q)], max_choices=1, shuffle=False)
