@@ -110,9 +110,8 @@ class MoodleWriter:
         grade = moodle_fraction(value)
         if grade is None:
             raise self.text.error(q, _(
-                "Moodle has no grade of {value} for one answer (its grades include 1/2 to "
-                "1/10 of the marks, not 1/{count})").format(
-                    value=format_percent(abs(value), get_language()), count=value.denominator))
+                "Moodle has no grade of {fraction} of the marks for one answer (its list has "
+                "1/2 to 1/10, 1/20 and a few others)").format(fraction=abs(value)))
         return percent(grade)
 
     def multichoice(self, q: Question, fractions: Mapping[str, Fraction], single: bool) -> El:
