@@ -1,4 +1,4 @@
-"""``autograder quiz``: list, lint, render, take, score, key and serve quizzes.
+"""``autograder quiz``: list, lint, render, export, take, score, key and serve quizzes.
 
 A thin click layer: each command calls plain functions of the quiz package, and every
 bad input becomes one line naming the file (see ``autograder.commands.exits``).
@@ -128,6 +128,47 @@ def render_command(quizzes: tuple[str, ...], lang: str | None, fmt: str, seed: s
                 path = out / f"{qf.quiz.id}.{code}.mdx"
                 path.write_text(render_markdown(qf.quiz, code, seed), encoding="utf-8")
                 click.echo(str(path))
+
+
+@quiz_cli.command("export")
+@click.argument("quizzes", nargs=-1)
+@click.option("--format", "fmt", type=click.Choice(["moodle-xml", "qti"]), required=True,
+              help="moodle-xml: one Moodle XML file, every language in multilang spans; "
+                   "qti: an IMS QTI 2.1 package (zip) in one language.")
+@_lang_option
+@click.option("--out", "out", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="File to write (default: out/quizzes/NAME.moodle.xml or "
+                   "NAME.LANG.qti.zip, NAME the quiz id, or 'quizzes' for several).")
+@_errors
+def export_command(quizzes: tuple[str, ...], fmt: str, lang: str | None,
+                   out: Path | None) -> None:
+    """Write QUIZ (every quiz by default) for Moodle or a QTI 2.1 system such as Canvas.
+
+    moodle-xml carries every language the quiz lists (only --lang's, if given); qti
+    carries --lang's (English by default).  Both hold the key: give them to instructors.
+    """
+    from autograder.quiz.export import export_moodle_xml, export_qti
+
+    _use_lang(lang)
+    files = [find_quiz(q) for q in quizzes] if quizzes else load_all()
+    name = files[0].quiz.id if len(files) == 1 else "quizzes"
+    data: str | bytes
+    if fmt == "moodle-xml":
+        data = export_moodle_xml(files, (lang,) if lang else None)
+        out = out or Path("out/quizzes") / f"{name}.moodle.xml"
+    else:
+        data = export_qti(files, lang or "en")
+        out = out or Path("out/quizzes") / f"{name}.{lang or 'en'}.qti.zip"
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        if isinstance(data, str):
+            out.write_text(data, encoding="utf-8")
+        else:
+            out.write_bytes(data)
+    except OSError as exc:
+        raise UsageProblem(_("cannot write {path}: {error}").format(
+            path=out, error=exc.strerror or exc)) from None
+    click.echo(str(out))
 
 
 def _summary(quiz: Quiz, result: RunResult) -> str:

@@ -11,7 +11,7 @@ import abc
 import dataclasses
 from collections.abc import Mapping
 from fractions import Fraction
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 from autograder.i18n import _
 from autograder.quiz.localize import Localizer, format_number, terminal
@@ -19,6 +19,11 @@ from autograder.quiz.model import Option, Question, Quiz, check_id
 from autograder.quiz.shuffle import attempt_rng, shuffle_unpinned
 from autograder.quiz.views import OptionView, QuestionView
 from sim.content import Document
+
+if TYPE_CHECKING:  # the exports build on the types: imported only for annotations
+    from autograder.quiz.export.moodle import MoodleWriter
+    from autograder.quiz.export.qti import QtiItem, QtiWriter
+    from autograder.quiz.export.xml import El
 
 Where = tuple[str | int, ...]
 """Path of a question in its quiz file, ``("questions", index)``, for ``doc.error``."""
@@ -169,6 +174,19 @@ class QuestionType(abc.ABC):
     @abc.abstractmethod
     def markdown_lines(self, view: QuestionView) -> list[str]:
         """Markdown lines under the question's text and code, ending with a blank line."""
+
+    # The LMS exports (``quiz export``) --------------------------------------------------
+
+    def moodle_question(self, q: Question, moodle: MoodleWriter) -> El:
+        """The question in Moodle XML, made with ``moodle``'s builders (``multichoice``,
+        ``truefalse``, ``numerical``, ``ordering``; ``note`` for a scoring Moodle cannot
+        match).  A type without one stops the export with a message naming the question."""
+        raise moodle.unsupported(q)
+
+    def qti_item(self, q: Question, qti: QtiWriter) -> QtiItem:
+        """The question as a QTI 2.1 item, made with ``qti``'s builders (``choice``,
+        ``order``, ``numeric``).  A type without one stops the export, as above."""
+        raise qti.unsupported(q)
 
 
 # Shared by the types whose answer names options --------------------------------------------

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import math
 from fractions import Fraction
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from autograder.core.results import exact
 from autograder.i18n import N_, _
@@ -17,6 +17,11 @@ from autograder.quiz.types import register
 from autograder.quiz.types.base import Form, LintNote, QuestionType, Where, first_value
 from autograder.quiz.views import QuestionView
 from sim.content import Document
+
+if TYPE_CHECKING:
+    from autograder.quiz.export.moodle import MoodleWriter
+    from autograder.quiz.export.qti import QtiItem, QtiWriter
+    from autograder.quiz.export.xml import El
 
 # Urdu and Arabic-Indic digits and decimal separator, as a phone keyboard types them.
 _DIGITS = str.maketrans("۰۱۲۳۴۵۶۷۸۹٠١٢٣٤٥٦٧٨٩٫", "01234567890123456789.")
@@ -73,3 +78,9 @@ class Numeric(QuestionType):
     def markdown_lines(self, view: QuestionView) -> list[str]:
         unit = f" {markdown_inline(view.unit)}" if view.unit else ""
         return [f"{_('Answer:')} \\_\\_\\_\\_\\_\\_{unit}", ""]
+
+    def moodle_question(self, q: Question, moodle: MoodleWriter) -> El:
+        return moodle.numerical(q, q.answer, q.tolerance, q.unit)
+
+    def qti_item(self, q: Question, qti: QtiWriter) -> QtiItem:
+        return qti.numeric(q, q.answer, q.tolerance, q.unit)

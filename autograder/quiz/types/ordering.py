@@ -7,7 +7,7 @@ shown in key order; none may be pinned.
 from __future__ import annotations
 
 from fractions import Fraction
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from autograder.i18n import _
 from autograder.quiz.localize import markdown_inline
@@ -24,6 +24,11 @@ from autograder.quiz.types.base import (
 )
 from autograder.quiz.views import QuestionView
 from sim.content import Document
+
+if TYPE_CHECKING:
+    from autograder.quiz.export.moodle import MoodleWriter
+    from autograder.quiz.export.qti import QtiItem, QtiWriter
+    from autograder.quiz.export.xml import El
 
 
 @register
@@ -77,3 +82,9 @@ class Ordering(QuestionType):
     def markdown_lines(self, view: QuestionView) -> list[str]:
         return [_("Put these in order:"), "",
                 *(f"- [ ] {markdown_inline(o.text)}" for o in view.options), ""]
+
+    def moodle_question(self, q: Question, moodle: MoodleWriter) -> El:
+        return moodle.ordering(q, q.answer)
+
+    def qti_item(self, q: Question, qti: QtiWriter) -> QtiItem:
+        return qti.order(q, q.answer)

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from fractions import Fraction
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from autograder.i18n import _
 from autograder.quiz.localize import markdown_inline
@@ -19,6 +19,11 @@ from autograder.quiz.types.base import (
 )
 from autograder.quiz.views import QuestionView
 from sim.content import Document
+
+if TYPE_CHECKING:
+    from autograder.quiz.export.moodle import MoodleWriter
+    from autograder.quiz.export.qti import QtiItem, QtiWriter
+    from autograder.quiz.export.xml import El
 
 
 @register
@@ -49,3 +54,10 @@ class SingleChoice(QuestionType):
 
     def markdown_lines(self, view: QuestionView) -> list[str]:
         return [f"- ○ {markdown_inline(o.text)}" for o in view.options] + [""]
+
+    def moodle_question(self, q: Question, moodle: MoodleWriter) -> El:
+        return moodle.multichoice(q, {o.id: Fraction(o.id == q.answer) for o in q.options},
+                                  single=True)
+
+    def qti_item(self, q: Question, qti: QtiWriter) -> QtiItem:
+        return qti.choice(q, [q.answer], max_choices=1)

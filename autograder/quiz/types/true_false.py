@@ -8,7 +8,7 @@ that type's prompt, parsing, form and Markdown; answers may be ``"true"``/``"fal
 from __future__ import annotations
 
 from fractions import Fraction
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from autograder.i18n import _
 from autograder.quiz.localize import Localizer, Text
@@ -18,6 +18,11 @@ from autograder.quiz.types.base import Where, one_option_problem
 from autograder.quiz.types.single import SingleChoice
 from autograder.quiz.views import OptionView
 from sim.content import Document
+
+if TYPE_CHECKING:
+    from autograder.quiz.export.moodle import MoodleWriter
+    from autograder.quiz.export.qti import QtiItem, QtiWriter
+    from autograder.quiz.export.xml import El
 
 IDS = ("true", "false")
 
@@ -50,3 +55,10 @@ class TrueFalse(SingleChoice):
         # Always True then False, never shuffled: the order is part of how it reads.
         return (OptionView("true", Text(_("True"), loc.lang)),
                 OptionView("false", Text(_("False"), loc.lang)))
+
+    def moodle_question(self, q: Question, moodle: MoodleWriter) -> El:
+        return moodle.truefalse(q, q.answer)
+
+    def qti_item(self, q: Question, qti: QtiWriter) -> QtiItem:
+        # Two choices, True then False as the page shows them, never shuffled.
+        return qti.choice(q, [self.key(q)], max_choices=1, shuffle=False)
