@@ -3,6 +3,8 @@ file:line), the housekeeping checks, and the real course held to the real glossa
 
 from __future__ import annotations
 
+import json
+import re
 from pathlib import Path
 
 import pytest
@@ -262,3 +264,14 @@ def test_the_course_follows_its_glossary(real_course: None) -> None:
     result = CliRunner().invoke(quiz_cli, ["lint"])
     assert result.exit_code == 0, result.output
 
+
+def test_the_readme_answers_file_scores(real_course: None, tmp_path: Path) -> None:
+    """README.md's sample answers file is one `quiz score` accepts."""
+    text = (REPO / "README.md").read_text()
+    sample = re.search(r'An answers file looks\s+like `(\{"quiz".*?\}\})`', text, re.S)
+    assert sample, "README.md has no sample answers file"
+    answers = json.loads(sample.group(1).replace("\n", " "))
+    path = tmp_path / "answers.json"
+    path.write_text(json.dumps(answers))
+    result = CliRunner().invoke(quiz_cli, ["score", answers["quiz"], str(path)])
+    assert result.exit_code == 0, result.output
