@@ -55,7 +55,7 @@ def test_take_in_urdu_points_to_the_page() -> None:
     assert result.exit_code == 0, result.output
     assert "autograder quiz serve" in result.output
     assert "rclpy میں callback groups کا بنیادی مقصد کیا ہے؟" in result.output
-    assert "پاسنگ اسکور: 70% (4/5 سوالات)" in result.output
+    assert "کامیابی کے لیے درکار اسکور: 70% (4/5 سوالات)" in result.output
 
 
 def test_list_json() -> None:

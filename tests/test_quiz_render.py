@@ -60,7 +60,7 @@ def test_urdu_page_is_rtl_with_lang_on_the_root(urdu_page: str) -> None:
     assert re.search(r'<html lang="ur" dir="rtl">', urdu_page)
     assert '"Noto Nastaliq Urdu"' in urdu_page
     assert "line-height: 2.6" in urdu_page
-    assert "پاسنگ اسکور: 70% (4/5 سوالات)" in urdu_page
+    assert "کامیابی کے لیے درکار اسکور: 70% (4/5 سوالات)" in urdu_page
     assert "rclpy میں" not in urdu_page  # Latin runs are isolated, not bare
     assert '<bdi lang="en" dir="ltr">rclpy</bdi> میں' in urdu_page
 

@@ -59,7 +59,7 @@ def test_left_out_question_scores_zero() -> None:
 def test_pass_summary_in_both_languages() -> None:
     quiz = load_quiz(PART2).quiz
     assert pass_summary(quiz, "en") == "Passing score: 70% (4/5 questions)"
-    assert pass_summary(quiz, "ur") == "پاسنگ اسکور: 70% (4/5 سوالات)"
+    assert pass_summary(quiz, "ur") == "کامیابی کے لیے درکار اسکور: 70% (4/5 سوالات)"
     assert pass_summary(_quiz(1), "en") == "Passing score: 70% (1/1 question)"
 
 
@@ -175,9 +175,9 @@ def test_score_cli_writes_results_in_urdu(tmp_path: Path) -> None:
     data = json.loads(results.read_text())
     assert (data["score"], data["max_score"], data["passed"]) == (3, 5, False)
     assert data["quiz"] == "rclpy-part2" and data["lang"] == "ur"
-    assert data["pass_summary"] == "پاسنگ اسکور: 70% (4/5 سوالات)"
+    assert data["pass_summary"] == "کامیابی کے لیے درکار اسکور: 70% (4/5 سوالات)"
     assert [t["status"] for t in data["tests"]] == ["passed"] * 3 + ["failed"] * 2
-    assert data["tests"][4]["message"] == "جواب نہیں دیا گیا۔"
+    assert data["tests"][4]["message"] == "آپ نے جواب نہیں دیا۔"
     assert "ابھی کامیاب نہیں" in cli.output
 
 

@@ -59,7 +59,7 @@ def test_urdu_page_and_submit(server: QuizServer) -> None:
     assert status == 200
     assert 'id="verdict"' in result and "کامیاب" in result and "ابھی کامیاب نہیں" not in result
     assert "5 میں سے 4 (80%)" in result
-    assert "پاسنگ اسکور: 70% (4/5 سوالات)" in result
+    assert "کامیابی کے لیے درکار اسکور: 70% (4/5 سوالات)" in result
     assert "download=\"answers.json\"" in result
 
 

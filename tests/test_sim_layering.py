@@ -48,7 +48,7 @@ def test_sim_messages_follow_the_autograder_language(urdu: None, tmp_path: Path)
         load_world(empty)
     outside = tmp_path / "outside.yaml"
     outside.write_text("goal: {x: 9, y: 1}\n")
-    with pytest.raises(ContentError, match="ہدف arena سے باہر ہے"):  # the goal is outside
+    with pytest.raises(ContentError, match="منزل احاطے سے باہر ہے"):  # the goal is outside
         load_world(outside)
 
 

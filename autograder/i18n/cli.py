@@ -15,6 +15,7 @@ from autograder.commands.exits import UsageProblem, report_problems
 from autograder.core.course import course_root
 from autograder.core.errors import ContentError
 from autograder.i18n import LANGUAGES, _, locales_dir
+from autograder.i18n.glossary import check_language
 from autograder.i18n.tools import check_catalog, compile_catalogs, extract, update
 
 _TARGETS = tuple(lang for lang in LANGUAGES if lang != "en")
@@ -68,12 +69,16 @@ def compile_command() -> None:
 @click.option("--lang", "langs", multiple=True, type=click.Choice(_TARGETS),
               default=_TARGETS, show_default=True, help="Catalogs to check.")
 def check_command(langs: tuple[str, ...]) -> None:
-    """Every template string translated, not fuzzy, placeholders kept (file:line: message)."""
+    """Every template string translated, not fuzzy, placeholders kept; no obsolete entries
+    or template headers; the glossary followed in the catalogs and the exercise READMEs
+    (file:line: message)."""
     locales = locales_dir()
     problems = []
     for template in sorted(locales.glob("*.pot")):
         for lang in langs:
             po = locales / lang / "LC_MESSAGES" / f"{template.stem}.po"
             problems += check_catalog(template, po, lang)
+    for lang in langs:
+        problems += check_language(locales, lang, course_root())
     report_problems(problems)
     click.echo(_("All catalogs are complete."))

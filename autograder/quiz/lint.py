@@ -2,7 +2,9 @@
 
 Quiz files load (ids unique, keys valid), settings a question's type doubts are reported
 (a numeric tolerance that also accepts 0), and every string is translated, not fuzzy, with
-its placeholders and code unchanged, in every language the quiz is offered in.
+its placeholders and code unchanged, in every language the quiz is offered in.  The
+translations follow the language's glossary (``locales/<lang>/glossary.yaml``), and the
+content catalog has no obsolete entries and no header left at template values.
 """
 
 from __future__ import annotations
@@ -11,6 +13,7 @@ from pathlib import Path
 
 from autograder.core.errors import ContentError
 from autograder.i18n import locales_dir
+from autograder.i18n.glossary import Glossary, as_problem, glossary_for, housekeeping
 from autograder.i18n.tools import Problem, check_message, read_catalog
 from autograder.quiz import CONTENT_DOMAIN
 from autograder.quiz.catalog import quiz_paths
@@ -42,6 +45,7 @@ def lint(root: Path | None = None, locales: Path | None = None) -> list[Problem]
             problems.append(_problem(exc))
     problems += [_problem(e) for e in check_ids_unique(files)]
     catalogs: dict[str, object] = {}
+    glossaries: dict[str, Glossary | None] = {}
     for qf in files:
         problems += _type_notes(qf)
         for lang in qf.quiz.languages:
@@ -54,10 +58,21 @@ def lint(root: Path | None = None, locales: Path | None = None) -> list[Problem]
                 except ContentError as exc:
                     catalogs[lang] = None
                     problems.append(Problem(exc.path, exc.line, exc.message))
+                    continue
+                problems += housekeeping(po)
+                try:
+                    glossaries[lang] = glossary_for(locales, lang)
+                except ContentError as exc:
+                    glossaries[lang] = None
+                    problems.append(as_problem(exc))
             catalog = catalogs[lang]
             if catalog is None:
                 continue
+            glossary = glossaries.get(lang)
+            lines = po.read_text(encoding="utf-8").splitlines() if glossary else []
             for s in strings(qf):
                 found = catalog.get(s.text, context=s.context)  # type: ignore[attr-defined]
                 problems += check_message(po, lang, found, s.context, at=(qf.path, s.line))
+                if glossary is not None and found is not None and found.string:
+                    problems += glossary.check_message(po, found, lines)
     return problems
