@@ -225,3 +225,25 @@ def test_urdu_report_has_no_english_collisions_or_world_names(urdu_catalog: Path
     for urdu in ("دیوار 3", "ڈبہ 1", "دائرہ 2", "<title>خالی کمرہ، 6 x 6 m</title>",
                  "<bdi>چند رکاوٹوں والا کمرہ</bdi>: روبوٹ کا راستہ"):
         assert urdu in page, urdu
+
+
+def test_a_programs_output_in_a_message_stays_left_to_right_line_by_line() -> None:
+    """An Urdu message that ends with the program's output: the sentence is right to left,
+    the traceback is kept line by line in a left-to-right block (folded into the sentence
+    it read backwards)."""
+    from autograder.quiz.localize import with_output
+
+    message = ("نوڈ کا پروسیس ختم ہو گیا۔ اس کی آخری سطریں:\n"
+               'Traceback (most recent call last):\n  File "avoider.py", line 55\n'
+               "ValueError: min() arg is an empty sequence")
+    html = str(with_output(ur(message)))
+    head, _sep, block = html.partition('<pre class="output" dir="ltr" lang="en">')
+    assert "اس کی آخری سطریں:" in head and "Traceback" not in head
+    assert block.startswith("Traceback (most recent call last):\n  File &#34;avoider.py&#34;, "
+                            "line 55\nValueError") and block.endswith("</pre>")
+    assert "<pre" not in str(with_output(ur("ایک جملہ: بس یہی")))  # nothing follows the colon
+
+
+def test_a_chain_of_calls_is_one_latin_run() -> None:
+    html = str(rich(ur("یاد رکھیں کہ آخری scan کب آیا (self.get_clock().now()) میں")))
+    assert '<bdi lang="en" dir="ltr">self.get_clock().now()</bdi>' in html

@@ -27,7 +27,9 @@ CODE_SPAN = re.compile(r"`([^`]+)`")
 # their units ("50 Hz", "±0.5 rad/s", "default 0.5"), words joined by single spaces.  A
 # sign that leads a word (±, +, -, −) belongs to the run: left outside the isolate, the
 # bidi algorithm would place it on the wrong side.
-_WORD = r"[±∓+\u2212-]?[A-Za-z0-9_][\w./+=±°-]*(?:\(\))?"
+# An empty call may come anywhere in a chain ("self.get_clock().now()"): cut at its
+# parentheses, the chain's pieces would be laid out in the wrong order.
+_WORD = r"[±∓+\u2212-]?[A-Za-z0-9_][\w./+=±°-]*(?:\(\)[\w./+=±°-]*)*"
 LATIN_RUN = re.compile(rf"{_WORD}(?: {_WORD})*", re.ASCII)
 # A bare number (digits and separators: 0.25, 4/5, 1,000): Urdu text holds those as they
 # are, in its own digits' face.
@@ -165,6 +167,20 @@ def rich(text: Text) -> Markup:
     if text.fallback:
         return Markup('<span lang="en" dir="ltr" class="fallback">{}</span>').format(html)
     return html
+
+
+def with_output(text: Text) -> Markup:
+    """A test's message that may end with a program's output ("Last lines of its output:"
+    and the lines after it): the sentences as :func:`rich` text, the output kept as the
+    program wrote it, line by line and left to right, in ``<pre class="output">`` (in an
+    Urdu report, a traceback folded into the right-to-left paragraph reads backwards)."""
+    lines = text.value.split("\n")
+    for i, line in enumerate(lines[:-1]):
+        if line.rstrip().endswith(":"):
+            head = Text("\n".join(lines[:i + 1]), text.lang, text.fallback)
+            return Markup('{}<pre class="output" dir="ltr" lang="en">{}</pre>').format(
+                rich(head), "\n".join(lines[i + 1:]))
+    return rich(text)
 
 
 _FIELD = re.compile(r"(\{[^{}]*\})")

@@ -26,6 +26,7 @@ from autograder.quiz.localize import (
     rich,
     sentence,
     using_language,
+    with_output,
 )
 from autograder.quiz.model import Quiz
 from autograder.quiz.scoring import pass_summary
@@ -46,7 +47,7 @@ def _environment() -> jinja2.Environment:
         trim_blocks=True, lstrip_blocks=True, undefined=jinja2.StrictUndefined)
     env.globals.update(_=_, ngettext=ngettext, font_stack_ur=Markup(FONT_STACK_UR),
                        font_stack_latin=Markup(FONT_STACK_LATIN))
-    env.filters.update(rich=rich, plain=plain, bidi=sentence)
+    env.filters.update(rich=rich, plain=plain, bidi=sentence, with_output=with_output)
     return env
 
 
