@@ -117,7 +117,9 @@ def test_latin_words_running_together_and_keep_comments(tmp_path: Path) -> None:
 
 def test_readme_prose_comments_and_title(tmp_path: Path) -> None:
     readme = (
-        "# Timers: ایک کوڈ\n"                                       # line 1: not the title
+        '<div dir="rtl" lang="ur">\n'
+        "\n"
+        "# Timers: ایک کوڈ\n"                                       # line 3: not the title
         "\n"
         "یہ `node` کوڈ ہے، مگر یہ node نہیں۔\n"                       # line 3
         "\n"
@@ -129,19 +131,32 @@ def test_readme_prose_comments_and_title(tmp_path: Path) -> None:
         "\n"
         "جو callback\n"
         "group رکا ہو وہ ٹھیک ہے، مگر یہ callback\n"
-        "parameter غلط ہے۔\n")                                        # line 13
+        "parameter غلط ہے۔\n"                                        # line 15
+        "\n</div>\n")
     course = _course(tmp_path, "", readme)
     path = course / "assignments" / "timers" / "README.ur.md"
     found = _check(course)
-    assert found[0] == (f"{path}:1: ur: the title 'Timers: ایک کوڈ' is not the catalog's title "
+    assert found[0] == (f"{path}:3: ur: the title 'Timers: ایک کوڈ' is not the catalog's title "
                         "of the exercise, 'Timers: ایک نوڈ'")
-    assert found[1].startswith(f"{path}:3: ur: 'node' goes against")
-    assert found[2] == f"{path}:6: ur: a comment in a code block is not translated: " \
+    assert found[1].startswith(f"{path}:5: ur: 'node' goes against")
+    assert found[2] == f"{path}:8: ur: a comment in a code block is not translated: " \
                        "'copies the starter'"
-    assert found[3].startswith(f"{path}:8: ur: 'node' goes against")
-    assert found[4].startswith(f"{path}:13: ur: Latin words run together into one "
+    assert found[3].startswith(f"{path}:10: ur: 'node' goes against")
+    assert found[4].startswith(f"{path}:15: ur: Latin words run together into one "
                                "left-to-right run: 'callback parameter'")
     assert len(found) == 5
+
+
+def test_an_urdu_readme_is_wrapped_right_to_left(tmp_path: Path) -> None:
+    """GitHub lays a README out paragraph by paragraph, left to right where a paragraph
+    starts with a Latin word: an Urdu README is wrapped in <div dir="rtl">."""
+    wrapped = '<div dir="rtl" lang="ur">\n\n# Timers: ایک نوڈ\n\nیہ ایک نوڈ ہے۔\n\n</div>\n'
+    course = _course(tmp_path, "", wrapped)
+    assert _check(course) == []
+    bare = wrapped.replace('<div dir="rtl" lang="ur">\n\n', "").replace("\n\n</div>", "")
+    (course / "assignments" / "timers" / "README.ur.md").write_text(bare, encoding="utf-8")
+    (found,) = _check(course)
+    assert "README.ur.md:1: a right-to-left README is wrapped in" in found
 
 
 def test_obsolete_entries_and_template_headers_fail(tmp_path: Path) -> None:

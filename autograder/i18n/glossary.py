@@ -239,9 +239,18 @@ class Glossary:
         except OSError as exc:
             return [Problem(path, None, _("cannot read file: {error}").format(error=exc))]
         problems: list[Problem] = []
+        body = [n for n, text in enumerate(lines, 1) if text.strip()]
+        if not body or lines[body[0] - 1].strip() != RTL_OPEN \
+                or lines[body[-1] - 1].strip() != "</div>":
+            problems.append(Problem(path, body[0] if body else 1, _(
+                "a right-to-left README is wrapped in {open} ... </div> (with a blank line "
+                "after the opening tag), so GitHub lays it out right to left").format(
+                    open=RTL_OPEN)))
         fenced = False
         previous = ""
         for n, text in enumerate(lines, 1):
+            if HTML_WRAPPER.match(text):
+                continue
             if text.lstrip().startswith("```"):
                 fenced = not fenced
                 previous = ""
@@ -331,6 +340,13 @@ def housekeeping(po: Path) -> list[Problem]:
             problems.append(Problem(po, n, _(
                 "obsolete entry (#~): its English is no longer in the template; delete it")))
     return problems
+
+
+# GitHub lays a Markdown file out left to right, paragraph by paragraph (dir=auto): an
+# Urdu paragraph that starts with a Latin word would show left to right. A wrapping div
+# (Markdown still works inside it after a blank line) sets the direction for the whole.
+RTL_OPEN = '<div dir="rtl" lang="ur">'
+HTML_WRAPPER = re.compile(r"\s*</?div\b[^>]*>\s*$")
 
 
 def title_problem(path: Path, lang: str, title: str) -> Problem | None:
