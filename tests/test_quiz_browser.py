@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import threading
 from collections.abc import Iterator
@@ -82,13 +83,21 @@ _LAYOUT_JS = """
 """
 
 
-def test_urdu_page_renders_rtl_in_nastaliq_unclipped(tmp_path: Path) -> None:
-    quiz = load_quiz(REPO / "quizzes" / "part2-rclpy.yaml").quiz
-    html = tmp_path / "rclpy-part2.ur.html"
+@contextlib.contextmanager
+def urdu_page(tmp_path: Path, quiz_file: str) -> Iterator[Any]:
+    """The Urdu page of ``quizzes/<quiz_file>.yaml`` (seed 7) open in Chromium, fonts
+    loaded."""
+    quiz = load_quiz(REPO / "quizzes" / f"{quiz_file}.yaml").quiz
+    html = tmp_path / f"{quiz_file}.ur.html"
     html.write_text(render_page(quiz, "ur", seed=7), encoding="utf-8")
     with chromium_page() as page:
         page.goto(html.as_uri())
         page.evaluate("document.fonts.ready")
+        yield page
+
+
+def test_urdu_page_renders_rtl_in_nastaliq_unclipped(tmp_path: Path) -> None:
+    with urdu_page(tmp_path, "part2-rclpy") as page:
         layout = page.evaluate(_LAYOUT_JS)
         png = page.screenshot(full_page=True, path=str(tmp_path / "quiz-rclpy-part2-ur.png"))
         title = page.locator("h1").bounding_box()
@@ -131,12 +140,7 @@ _APART_JS = """
 def test_question_beginning_with_a_number_keeps_its_number_apart(tmp_path: Path) -> None:
     # "50 Hz اور 10 Hz ..." numbered 5 once read "5.50 Hz": the bidi algorithm joined the
     # number's "5." and the text's "50" into one left-to-right number.
-    quiz = load_quiz(REPO / "quizzes" / "timer-synchronization.yaml").quiz
-    html = tmp_path / "timer-synchronization.ur.html"
-    html.write_text(render_page(quiz, "ur", seed=7), encoding="utf-8")
-    with chromium_page() as page:
-        page.goto(html.as_uri())
-        page.evaluate("document.fonts.ready")
+    with urdu_page(tmp_path, "timer-synchronization") as page:
         found = page.evaluate(_APART_JS, "q-keep-in-step-text")
         page.locator("#q-keep-in-step-text").screenshot(path=str(tmp_path / "q5-ur.png"))
     assert found["numberBidi"] == "isolate"
@@ -149,12 +153,7 @@ def test_question_beginning_with_a_number_keeps_its_number_apart(tmp_path: Path)
 
 
 def test_latin_runs_in_urdu_are_english_in_a_latin_face(tmp_path: Path) -> None:
-    quiz = load_quiz(REPO / "quizzes" / "timer-synchronization.yaml").quiz
-    html = tmp_path / "timer-synchronization.ur.html"
-    html.write_text(render_page(quiz, "ur", seed=7), encoding="utf-8")
-    with chromium_page() as page:
-        page.goto(html.as_uri())
-        page.evaluate("document.fonts.ready")
+    with urdu_page(tmp_path, "timer-synchronization") as page:
         family = page.evaluate(
             "getComputedStyle(document.querySelector('.question bdi:lang(en)')).fontFamily")
         runs = fonts_used(page, ".question bdi")
