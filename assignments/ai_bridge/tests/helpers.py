@@ -14,6 +14,7 @@ from std_msgs.msg import String
 
 from autograder.core.errors import StudentFailure
 from autograder.i18n import _
+from autograder.plugin.collisions import with_front_beam_note
 
 REACHED = 0.3              # m from the goal: inside counts as reached
 STILL = 0.02               # m/s: slower than this counts as stopped
@@ -39,6 +40,7 @@ class Mission:
     end: float = 0.0
     statuses: list[tuple[float, str]] = field(default_factory=list)
     output_tail: str = ""
+    geometry: Any = None  # the world's shapes (World.geometry), to tell where a hit was
 
     @property
     def distance(self) -> float:
@@ -105,6 +107,7 @@ def fly(world: Any, probe: Any, student: Any, limit: float) -> Mission:
         s for s in recording.snapshot()[0] if s.t >= mission.t0], recording.snapshot()[1]
     mission.statuses = [(t, m.data) for t, m in status.items]
     mission.output_tail = student.output_tail(12)
+    mission.geometry = world.world.geometry
     return mission
 
 
@@ -119,6 +122,9 @@ def judge_reached(mission: Mission, credit: Any, world_name: str) -> None:
                     "{seconds:.1f} s, having covered {share:.0%} of the way to the goal.").format(
             world=world_name, what=hit.description, x=hit.x, y=hit.y,
             seconds=hit.t - mission.t0, share=progress)
+        until = mission.died_at if mission.died_at is not None else math.inf
+        message = with_front_beam_note(message, [hit], mission.samples, mission.geometry,
+                                       since=mission.t0, until=until)
         hint = _("Steer by the lidar: never drive toward a direction whose readings are "
                  "closer than the robot needs to pass.")
     elif mission.died_at is not None:

@@ -17,6 +17,7 @@ from helpers import LATE, describe, is_zero, warnings_between, window
 
 from autograder.core.errors import StudentFailure
 from autograder.i18n import _
+from autograder.plugin.collisions import with_front_beam_note
 from sim.worldfile import Fault
 
 pytestmark = pytest.mark.world("obstacles")
@@ -142,13 +143,15 @@ def test_stays_alive(run, student):
 def test_never_collides(run, world, student):
     """The robot never touches an obstacle or a wall"""
     _died(run, student)
-    _, collisions = world.recording.snapshot()
+    samples, collisions = world.recording.snapshot()
     if collisions:
         first = collisions[0]
         raise StudentFailure(
-            _("The robot hit {what} at ({x:.2f}, {y:.2f}), {seconds:.1f} s into the run.")
-            .format(what=first.description, x=first.x, y=first.y,
-                    seconds=first.t - run.start),
+            with_front_beam_note(
+                _("The robot hit {what} at ({x:.2f}, {y:.2f}), {seconds:.1f} s into the run.")
+                .format(what=first.description, x=first.x, y=first.y,
+                        seconds=first.t - run.start),
+                collisions, samples, world.world.geometry),
             _("Stop going forward when the nearest valid reading within ±30° of ahead is "
               "0.6 m or nearer; do not let invalid readings hide an obstacle."))
 
