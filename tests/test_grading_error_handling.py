@@ -38,3 +38,14 @@ def test_shutdown_failure_shows_the_traceback(graded):
     message = by_name["test_clean_exit_on_sigint"].message
     assert re.search(r"After SIGINT \(trial [123] of 3\)", message), message
     assert "Traceback" in message
+
+
+def test_driving_into_what_is_ahead_is_told_which_beam_is_front(graded):
+    """The book's mistake (ranges[len(ranges)//2] as "front") drives head on into a box;
+    the collision's message says that beam 0 is straight ahead and the middle one behind."""
+    by_name = {t.name: t for t in graded["middle_beam_front"].tests}
+    message = by_name["test_never_collides"].message
+    assert "The robot drove into box 0 straight ahead." in message, message
+    assert "beam 0 of /scan is straight ahead" in message
+    assert "ranges[len(ranges)//2] is straight behind" in message
+    assert message.count("straight ahead.") == 1
