@@ -94,12 +94,16 @@ def _quizzes() -> list:
 @click.argument("exercise")
 @click.argument("directory", required=False, type=click.Path(path_type=Path))
 def start(exercise: str, directory: Path | None) -> None:
-    """Copy an exercise's starter code and README into DIRECTORY (default: the exercise id)."""
+    """Copy an exercise's starter code, README and own world file into DIRECTORY (default:
+    the exercise id)."""
     found = _exercise(exercise)
     target = directory or Path(found.id)
     target.mkdir(parents=True, exist_ok=True)
     copied = []
-    for source in (found.starter, *sorted(found.folder.glob("README*.md"))):
+    # A world kept in the exercise's folder goes too: the README's hand run names it there.
+    world = found.folder / found.world
+    own_world = [world] if world.suffix in (".yaml", ".yml") and world.is_file() else []
+    for source in (found.starter, *sorted(found.folder.glob("README*.md")), *own_world):
         dest = target / source.name
         if dest.exists():
             raise UsageProblem(_("{path} already exists; not overwriting your work").format(
