@@ -28,6 +28,7 @@ class RunSettings:
     real_time_factor: float | None = None  # overrides the exercise's
     isolation: Literal["strict", "basic"] = "basic"  # as the grader chose it
     lang: str = "en"
+    record: str | None = None  # a folder: each test module's graph recorded as a bag in it
 
     @property
     def strict(self) -> bool:
