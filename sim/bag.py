@@ -51,6 +51,18 @@ TF_QOS = qos(depth=100)
 TF_STATIC_QOS = qos(depth=1, durability="transient_local")
 
 
+class _Dumper(yaml.SafeDumper):
+    """YAML as yaml-cpp writes it: a profile shared by two topics is written out twice,
+    not as an anchor and an alias."""
+
+    def ignore_aliases(self, data: Any) -> bool:
+        return True
+
+
+def _yaml(data: Any) -> str:
+    return yaml.dump(data, Dumper=_Dumper, sort_keys=False)
+
+
 def nanoseconds(seconds: float) -> int:
     return max(0, round(seconds * 1e9))
 
@@ -104,7 +116,7 @@ class BagWriter:
             self._schemas[type_name] = schema
         profiles = [profile]
         channel = self._mcap.register_channel(name, "cdr", schema, {
-            "offered_qos_profiles": yaml.safe_dump(profiles, sort_keys=False),
+            "offered_qos_profiles": _yaml(profiles),
             "topic_type_hash": msgdefs.type_hash(type_name)})
         topic = self.topics[name] = _Topic(name, type_name, profiles, channel)
         return topic
@@ -141,13 +153,12 @@ class BagWriter:
         info = self.metadata()
         try:
             self._mcap.add_metadata("rosbag2", {
-                "serialized_metadata": yaml.safe_dump(info, sort_keys=False)})
+                "serialized_metadata": _yaml(info)})
             self._mcap.finish()
         finally:
             self._stream.close()
         (self.directory / "metadata.yaml").write_text(
-            yaml.safe_dump({"rosbag2_bagfile_information": info}, sort_keys=False),
-            encoding="utf-8")
+            _yaml({"rosbag2_bagfile_information": info}), encoding="utf-8")
         return self.directory
 
 

@@ -137,7 +137,9 @@ def test_transforms_chain_odom_base_footprint_base_scan(recorded: Path) -> None:
 
 def test_metadata_yaml_matches_the_mcap(recorded: Path) -> None:
     summary, messages, records = _read(recorded)
-    info = yaml.safe_load((recorded / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
+    text = (recorded / "metadata.yaml").read_text()
+    assert "&" not in text and "*" not in text  # no YAML anchors or aliases
+    info = yaml.safe_load(text)["rosbag2_bagfile_information"]
     assert (info["version"], info["storage_identifier"], info["ros_distro"]) == (9, "mcap", "jazzy")
     assert info["relative_file_paths"] == ["run_0.mcap"]
     assert (recorded / "run_0.mcap").is_file()
