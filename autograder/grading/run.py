@@ -75,7 +75,7 @@ def _record_folder(record: Path | None) -> tuple[Path | None, list[str]]:
         record = Path(record).resolve()
         record.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        return None, [_("The grading could not be recorded in {path}: {error}").format(
+        return None, [_("The run could not be recorded in {path}: {error}").format(
             path=record, error=exc)]
     return record, []
 

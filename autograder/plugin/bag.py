@@ -56,7 +56,7 @@ def open_bag(request: pytest.FixtureRequest, bridge: SimBridge,
                                custom_data={"exercise": Path(settings.exercise).name,
                                             "test_module": request.node.nodeid, "world": world})
     except Exception as exc:  # noqa: BLE001 - no recording is no reason to fail a test
-        _warn(request, [_("The grading could not be recorded in {path}: {error}").format(
+        _warn(request, [_("The run could not be recorded in {path}: {error}").format(
             path=folder, error=exc)])
         return None
     bridge.add_tap(recorder)
