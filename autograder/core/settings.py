@@ -4,7 +4,7 @@ The grader (:mod:`autograder.grading.run`) writes a :class:`RunSettings` as JSON
 child's single ``--autograder-settings`` option; the plugin (:mod:`autograder.plugin`)
 reads it back. An instructor running an exercise's tests by hand gives the same settings
 as ordinary options (``--exercise``, ``--submission``, ``--ros-domain``,
-``--real-time-factor``).
+``--real-time-factor``, ``--record-bags``).
 """
 
 from __future__ import annotations
