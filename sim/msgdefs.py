@@ -42,7 +42,7 @@ class DefinitionNotFound(LookupError):
 
 def type_name(message_type: type) -> str:
     """``pkg/msg/Type`` of an rclpy message class (e.g. ``geometry_msgs/msg/Twist``)."""
-    package, kind = message_type.__module__.split(".")[:2]
+    package, kind = [*message_type.__module__.split("."), "msg"][:2]  # never raises
     return f"{package}/{kind}/{message_type.__name__}"
 
 

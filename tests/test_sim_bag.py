@@ -217,6 +217,7 @@ def test_the_embedded_tf_message_hash_is_the_one_rosidl_computes() -> None:
 
 def test_type_names_and_full_text_follow_rosbag2() -> None:
     assert msgdefs.type_name(Twist) == "geometry_msgs/msg/Twist"
+    assert msgdefs.type_name(type("Odd", (), {"__module__": "odd"})) == "odd/msg/Odd"
     text = msgdefs.full_text("geometry_msgs/msg/Twist")
     own, _, rest = text.partition("\n" + "=" * 80 + "\n")
     assert "Vector3  linear" in own
