@@ -117,7 +117,7 @@ def start(exercise: str, directory: Path | None) -> None:
 
 
 def _run(exercise: str, submission: Path, hidden: bool, outputs: dict[str, Path | None],
-         rtf: float | None, domain: int | None) -> None:
+         rtf: float | None, domain: int | None, record: Path | None = None) -> None:
     from autograder.core.report import RawTest
     from autograder.core.results import TestResult, exact
     from autograder.core.submission import SubmissionNotFound, locate
@@ -144,11 +144,27 @@ def _run(exercise: str, submission: Path, hidden: bool, outputs: dict[str, Path 
     click.echo(for_terminal(_("Grading {file} for {exercise} in the simulator...").format(
         file=submission, exercise=found.id)), err=True)
     result = grade(found, submission, hidden=hidden, domain=domain, real_time_factor=rtf,
-                   progress=progress)
+                   progress=progress, record=record)
     click.echo(to_terminal(result, color=color))
+    _say_recorded(result, record)
     write_outputs(result, outputs, found.folder)
     if result.grader_error:
         raise GraderFault(result.grader_error)
+
+
+def _say_recorded(result, record: Path | None) -> None:  # noqa: ANN001 - a RunResult
+    """Where ``--record`` put the bags, and any warning about them (on stderr)."""
+    from autograder.i18n import ngettext
+    from autograder.render.terminal import for_terminal
+
+    bags = result.data.get("bags", {})
+    if record is not None and bags:
+        click.echo(for_terminal(ngettext(
+            "{count} recording (rosbag2, MCAP) written to {path}",
+            "{count} recordings (rosbag2, MCAP) written to {path}", len(bags)).format(
+            count=len(bags), path=record)), err=True)
+    for warning in result.data.get("warnings", []):
+        click.echo(for_terminal(_("Warning: {message}").format(message=warning)), err=True)
 
 
 def write_outputs(result, outputs: dict[str, Path | None], folder: Path) -> None:  # noqa: ANN001
@@ -184,6 +200,9 @@ _rtf = click.option("--real-time-factor", "rtf", type=float, default=None,
                     help="Override the exercise's simulation pace.")
 _domain = click.option("--domain", type=click.IntRange(0, 232), default=None,
                        help="ROS domain id (default: a free one, reserved for the run).")
+_record = click.option("--record", type=click.Path(path_type=Path, file_okay=False),
+                       default=None, help="Record each test module's ROS graph as a rosbag2 "
+                       "bag (MCAP) in this folder.")
 
 
 @main.command()
@@ -192,11 +211,12 @@ _domain = click.option("--domain", type=click.IntRange(0, 232), default=None,
 @_formats
 @_rtf
 @_domain
+@_record
 @_lang_option
 def check(exercise: str, submission: Path, rtf: float | None, domain: int | None,
-          **outputs: Path | None) -> None:
+          record: Path | None, **outputs: Path | None) -> None:
     """Run the public tests of EXERCISE on SUBMISSION (for students)."""
-    _run(exercise, submission, False, outputs, rtf, domain)
+    _run(exercise, submission, False, outputs, rtf, domain, record)
 
 
 @main.command("grade")
@@ -205,12 +225,13 @@ def check(exercise: str, submission: Path, rtf: float | None, domain: int | None
 @_formats
 @_rtf
 @_domain
+@_record
 @_lang_option
 def grade_command(exercise: str, submission: Path, rtf: float | None, domain: int | None,
-                  **outputs: Path | None) -> None:
+                  record: Path | None, **outputs: Path | None) -> None:
     """Run the public and hidden tests of EXERCISE on SUBMISSION (the student's .py file or a
     folder holding it)."""
-    _run(exercise, submission, True, outputs, rtf, domain)
+    _run(exercise, submission, True, outputs, rtf, domain, record)
 
 
 @main.command()
@@ -256,9 +277,11 @@ def bundle_gradescope(exercise: str, zip_path: Path) -> None:
               help="Folder of each student's reports (default: grades/EXERCISE).")
 @click.option("--shard", default=None, metavar="I/N",
               help="Grade only share I of N (stable: by a hash of the student's name).")
+@click.option("--record", type=click.Path(path_type=Path, file_okay=False), default=None,
+              help="Record each student's grading as rosbag2 bags (MCAP) in RECORD/<student>.")
 @_lang_option
 def grade_batch(item: str, submissions: Path, jobs: int, csv_path: Path, out: Path | None,
-                shard: str | None) -> None:
+                shard: str | None, record: Path | None) -> None:
     """Grade every submission in SUBMISSIONS (one sub-folder or file per student), or score
     every answers file for a quiz. Resumable: graded students are skipped."""
     from autograder.commands.batch import parse_shard, run_batch, students
@@ -269,7 +292,7 @@ def grade_batch(item: str, submissions: Path, jobs: int, csv_path: Path, out: Pa
         raise UsageProblem(_("--shard must be I/N with 1 <= I <= N, got {value}").format(
             value=shard)) from None
     out = out or Path("grades") / item
-    grade_one, suffix, extra = _batch_item(item)
+    grade_one, suffix, extra = _batch_item(item, record)
 
     def progress(student: str, result) -> None:  # noqa: ANN001
         if result is None:
@@ -282,8 +305,9 @@ def grade_batch(item: str, submissions: Path, jobs: int, csv_path: Path, out: Pa
     click.echo(_("{count} rows in {path}").format(count=len(rows), path=csv_path))
 
 
-def _batch_item(item: str):  # noqa: ANN202
-    """How to grade one student's entry for an exercise or a quiz."""
+def _batch_item(item: str, record: Path | None = None):  # noqa: ANN202
+    """How to grade one student's entry for an exercise or a quiz (``record``: a folder
+    for each student's bags, exercises only)."""
     from autograder.grading.run import grade
     from autograder.quiz.catalog import find_quiz
     from autograder.quiz.scoring import read_answers, score
@@ -301,7 +325,14 @@ def _batch_item(item: str):  # noqa: ANN202
                      if f.batch_file and f.name != "results"}
             write_outputs(result, {**files, "log": folder / "output.log"}, exercise.folder)
 
-        return (lambda path: grade(exercise, path)), None, extra
+        def grade_one(path: Path):  # noqa: ANN202 - a RunResult
+            # The student's name as `students()` gives it: a folder's name, a file's stem.
+            student = path.name if path.is_dir() else path.stem
+            return grade(exercise, path, record=record / student if record else None)
+
+        return grade_one, None, extra
+    if record is not None:
+        raise UsageProblem(_("--record records exercise gradings, not quizzes"))
     try:
         quiz = find_quiz(item).quiz
     except ContentError as exc:

@@ -12,7 +12,8 @@ by :class:`sim.pacing.Pacer`; the bridge only steps the world and publishes.
 
 Physics runs in one thread and the executor (for /cmd_vel) in another; the world is
 only touched under the bridge's lock (the pacer's condition), and waiters are woken on it
-each tick.
+each tick.  Taps (:meth:`SimBridge.add_tap`, e.g. a :class:`sim.bag.BagRecorder`) see every
+message the bridge publishes or receives, with its simulation time.
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ import time
 from collections import Counter
 from collections.abc import Callable
 from contextlib import AbstractContextManager
+from typing import Any
 
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
@@ -37,6 +39,7 @@ from sensor_msgs.msg import LaserScan
 
 from sim.engine import SCAN_HZ, Outputs, Simulation
 from sim.faults import Scan
+from sim.msgdefs import type_name
 from sim.pacing import DEFAULT_CLOCK_HZ, DEFAULT_CPU_BUDGET, HoldOutcome, Pacer, PacingPolicy
 from sim.physics import World
 from sim.recorder import Recording, Sample
@@ -50,6 +53,9 @@ def _stamp(t: float) -> tuple[int, int]:
 
 class SimBridge:
     """Runs a :class:`World` as a ROS 2 robot in the given rclpy context."""
+
+    PUBLISHES = ("/clock", "/odom", "/scan")
+    SUBSCRIBES = ("/cmd_vel",)
 
     def __init__(self, world: World, context: Context, *, real_time_factor: float = 1.0,
                  max_clock_hz: float = DEFAULT_CLOCK_HZ, node_name: str = "sim_world",
@@ -68,6 +74,7 @@ class SimBridge:
         # (time.time_ns() just before a tick's /clock went out, that tick's sim time)
         self._clock_log: list[tuple[int, float]] = []
         self._threads: list[threading.Thread] = []
+        self._taps: list[Callable[[str, str, Any, float], None]] = []
         self.node = Node(node_name, context=context)
         qos = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
         self._clock_pub = self.node.create_publisher(Clock, "/clock", qos)
@@ -134,6 +141,15 @@ class SimBridge:
         """Add a fault at run time."""
         with self._cond:
             self.sim.inject(fault)
+
+    def add_tap(self, tap: Callable[[str, str, Any, float], None]) -> None:
+        """Hand every message published or received to ``tap(topic, type name, message,
+        sim time)`` (add taps before :meth:`start`; a tap must not raise)."""
+        self._taps.append(tap)
+
+    def _tap(self, topic: str, message: Any, t: float) -> None:
+        for tap in self._taps:
+            tap(topic, type_name(type(message)), message, t)
 
     def watch_pid(self, pid: int | None) -> None:
         """Also hold sim time back while process ``pid`` has work (None: watch nothing)."""
@@ -214,6 +230,7 @@ class SimBridge:
     # -- threads --------------------------------------------------------------------
     def _on_cmd_vel(self, msg: Twist) -> None:
         self._cmd = (msg.linear.x, msg.angular.z)
+        self._tap("/cmd_vel", msg, self.world.time)
 
     def _spin(self) -> None:
         while self._spinning and self._context.ok():
@@ -239,11 +256,16 @@ class SimBridge:
         clock.clock.sec, clock.clock.nanosec = sec, nanosec
         self._clock_log.append((time.time_ns(), self.world.time))
         self._clock_pub.publish(clock)
+        self._tap("/clock", clock, self.world.time)
         for out in outputs:
             if out.odom is not None:
-                self._odom_pub.publish(self._odometry(out.odom))
+                odom = self._odometry(out.odom)
+                self._odom_pub.publish(odom)
+                self._tap("/odom", odom, out.odom.t)
             if out.scan is not None:
-                self._scan_pub.publish(self._laser_scan(out.scan))
+                scan = self._laser_scan(out.scan)
+                self._scan_pub.publish(scan)
+                self._tap("/scan", scan, out.scan.t)
         self.pacer.note_tick(self.world.time)
         self._cond.notify_all()
 

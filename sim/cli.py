@@ -65,13 +65,15 @@ def check_command(file: Path) -> None:
               help="Write the trajectory and collisions as JSON here.")
 @click.option("--svg", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="Write a picture of the trajectory here.")
+@click.option("--record-bag", "bag", type=click.Path(file_okay=False, path_type=Path),
+              default=None, help="Record the world's topics as a rosbag2 bag (MCAP) here.")
 @click.option("--seed", type=int, default=None, help="Override the world's seed.")
 @click.option("--clock-hz", type=click.FloatRange(min=1.0), default=DEFAULT_CLOCK_HZ,
               show_default=True,
               help="Most /clock messages per wall second (as graded: Jazzy's "
                    "MultiThreadedExecutor stutters from about 50 Hz).")
 def run_command(world_name: str, rtf: float, duration: float | None, domain: int | None,
-                record: Path | None, svg: Path | None, seed: int | None,
+                record: Path | None, svg: Path | None, bag: Path | None, seed: int | None,
                 clock_hz: float) -> None:
     """Run a world on a ROS domain so a node started by hand can drive the robot.
 
@@ -81,14 +83,16 @@ def run_command(world_name: str, rtf: float, duration: float | None, domain: int
     spec = _load(world_name)
     domain = int(os.environ.get("ROS_DOMAIN_ID", "0")) if domain is None else domain
     summary = run_world(spec, rtf=rtf, duration=duration, domain=domain, seed=seed,
-                        record=record, svg=svg, clock_hz=clock_hz)
+                        record=record, svg=svg, clock_hz=clock_hz, bag=bag)
     click.echo(summary)
 
 
 def run_world(spec, *, rtf: float, duration: float | None, domain: int,  # noqa: ANN001
               seed: int | None = None, record: Path | None = None,
-              svg: Path | None = None, clock_hz: float = DEFAULT_CLOCK_HZ) -> str:
-    """Run ``spec`` on ``domain`` until ``duration`` sim seconds or Ctrl-C; return a summary."""
+              svg: Path | None = None, clock_hz: float = DEFAULT_CLOCK_HZ,
+              bag: Path | None = None) -> str:
+    """Run ``spec`` on ``domain`` until ``duration`` sim seconds or Ctrl-C; return a summary.
+    With ``bag``, the world's topics are recorded there as a rosbag2 bag."""
     import rclpy
     from rclpy.context import Context
 
@@ -99,6 +103,7 @@ def run_world(spec, *, rtf: float, duration: float | None, domain: int,  # noqa:
     ctx = Context()
     rclpy.init(context=ctx, domain_id=domain)
     bridge = SimBridge(World(spec, seed=seed), ctx, real_time_factor=rtf, max_clock_hz=clock_hz)
+    recorder = _recorder(bag, bridge, spec.name) if bag else None
     click.echo(_("World {name} on ROS domain {domain}, RTF {rtf}. Ctrl-C stops.").format(
         name=spec.name, domain=domain, rtf=rtf or _("max")))
     bridge.start()
@@ -111,12 +116,35 @@ def run_world(spec, *, rtf: float, duration: float | None, domain: int,  # noqa:
         effective = bridge.effective_rtf
         bridge.stop()
         rclpy.try_shutdown(context=ctx)
+    if recorder is not None:
+        written = recorder.close()
+        for warning in recorder.warnings():
+            click.echo(_("Warning: {message}").format(message=warning), err=True)
+        if written is not None:
+            click.echo(_("Recording (rosbag2, MCAP) written to {path}").format(path=written),
+                       err=True)
     recording = bridge.recording
     if record:
         record.write_text(json.dumps(recording.to_dict(), indent=1), encoding="utf-8")
     if svg:
         svg.write_text(trajectory_svg(spec, recording), encoding="utf-8")
     return _summary(spec, bridge, effective)
+
+
+def _recorder(folder: Path, bridge, world: str):  # noqa: ANN001, ANN202 - SimBridge, BagRecorder
+    """A bag recorder tapping ``bridge``; None (and a warning) if the bag cannot be made."""
+    from sim.bag import BagRecorder
+
+    try:
+        recorder = BagRecorder(folder, mount=getattr(bridge.sim.lidar, "mount", (0.0, 0.0, 0.0)),
+                               custom_data={"world": world})
+    except OSError as exc:
+        problem = _("The run could not be recorded in {path}: {error}").format(
+            path=folder, error=exc)
+        click.echo(_("Warning: {message}").format(message=problem), err=True)
+        return None
+    bridge.add_tap(recorder)
+    return recorder
 
 
 def _summary(spec, bridge, effective: float) -> str:  # noqa: ANN001

@@ -100,6 +100,11 @@ def _(message: str) -> str:
     return translations().gettext(message)
 
 
+def ngettext(singular: str, plural: str, n: int) -> str:
+    """Translate a message about ``n`` things (Urdu, like English, has two forms)."""
+    return translations().ngettext(singular, plural, n)
+
+
 def pgettext(context: str, message: str) -> str:
     """Translate ``message`` given in ``context`` (a world's title: context ``world``)."""
     return translations().pgettext(context, message)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import yaml
 from click.testing import CliRunner
 
 from sim.cli import sim_cli
@@ -35,3 +36,16 @@ def test_run_writes_record_and_svg(tmp_path: Path, ros_domain: int) -> None:
     assert "Goal reached: no" in result.output
     assert len(json.loads(record.read_text())["trajectory"]) >= 150
     assert svg.read_text().startswith("<svg")
+
+
+def test_run_records_a_bag(tmp_path: Path, ros_domain: int) -> None:
+    bag = tmp_path / "bag"
+    result = CliRunner().invoke(sim_cli, [
+        "run", "--world", "empty_room", "--rtf", "0", "--duration", "1", "--domain",
+        str(ros_domain), "--record-bag", str(bag)])
+    assert result.exit_code == 0, result.output
+    info = yaml.safe_load((bag / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
+    counts = {t["topic_metadata"]["name"]: t["message_count"]
+              for t in info["topics_with_message_count"]}
+    assert counts["/odom"] == counts["/tf"] >= 50 and counts["/scan"] >= 10  # 1 s or more
+    assert counts["/tf_static"] == 1 and (bag / "bag_0.mcap").is_file()

@@ -21,7 +21,7 @@ REPO = Path(__file__).resolve().parent.parent
 
 def test_sim_imports_nothing_of_autograder() -> None:
     code = ("import sys, sim.bridge, sim.cli, sim.worldfile, sim.content, sim.faults, "
-            "sim.engine, sim.svg, sim.recorder, sim.pacing, sim.procstate\n"
+            "sim.engine, sim.svg, sim.recorder, sim.pacing, sim.procstate, sim.bag\n"
             "leaked = sorted(m for m in sys.modules if m.split('.')[0] == 'autograder')\n"
             "assert not leaked, leaked\n")
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(

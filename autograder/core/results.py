@@ -139,6 +139,9 @@ class RunResult:
             # How the world paced itself per test module (see sim/bridge.py): for instructors
             # asking whether a verdict came from a slow node or a starved one.
             **({"pacing": self.data["pacing"]} if self.data.get("pacing") else {}),
+            # `--record DIR`: each test module's rosbag2 bag, and what kept one from being made.
+            **({"bags": self.data["bags"]} if self.data.get("bags") else {}),
+            **({"warnings": self.data["warnings"]} if self.data.get("warnings") else {}),
             "tests": [
                 {
                     "name": t.name,

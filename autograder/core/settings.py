@@ -4,7 +4,7 @@ The grader (:mod:`autograder.grading.run`) writes a :class:`RunSettings` as JSON
 child's single ``--autograder-settings`` option; the plugin (:mod:`autograder.plugin`)
 reads it back. An instructor running an exercise's tests by hand gives the same settings
 as ordinary options (``--exercise``, ``--submission``, ``--ros-domain``,
-``--real-time-factor``).
+``--real-time-factor``, ``--record-bags``).
 """
 
 from __future__ import annotations
@@ -28,6 +28,7 @@ class RunSettings:
     real_time_factor: float | None = None  # overrides the exercise's
     isolation: Literal["strict", "basic"] = "basic"  # as the grader chose it
     lang: str = "en"
+    record: str | None = None  # a folder: each test module's graph recorded as a bag in it
 
     @property
     def strict(self) -> bool:

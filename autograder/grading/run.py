@@ -36,21 +36,28 @@ GRADER_FAULT = "the autograder failed, tell your instructor"
 
 def grade(exercise: Exercise, submission: Path | None, *, hidden: bool = True,
           domain: int | None = None, real_time_factor: float | None = None,
-          progress: Callable[[dict[str, Any]], None] | None = None) -> RunResult:
+          progress: Callable[[dict[str, Any]], None] | None = None,
+          record: Path | None = None) -> RunResult:
     """Run the exercise's public (and, with ``hidden``, hidden) tests on ``submission``.
 
     ``submission`` is the student's file or a folder holding it; None grades the reference
     solution.  Always returns a result: a broken submission scores what it showed, a fault
-    of ours sets ``grader_error``.
+    of ours sets ``grader_error``.  With ``record``, each test module's graph is recorded
+    as a rosbag2 bag in that folder (``data["bags"]``); a recording that fails is only a
+    warning (``data["warnings"]``).
     """
     started = time.monotonic()
     isolation = detect()
+    record, warnings = _record_folder(record)
     try:
         with hold_domain(domain) as lock:
             result, raw = _run(exercise, submission, hidden, lock, isolation,
-                                  real_time_factor, progress, started)
+                                  real_time_factor, progress, started, record)
     except NoDomain as exc:
         return _fault(exercise, str(exc), time.monotonic() - started)
+    if warnings:
+        result = dataclasses.replace(result, data={
+            **result.data, "warnings": warnings + result.data.get("warnings", [])})
     processes = raw.processes
     bounds = processes[0].get("bounds") if processes else None
     return dataclasses.replace(result, data={
@@ -59,10 +66,24 @@ def grade(exercise: Exercise, submission: Path | None, *, hidden: bool = True,
         "student_uid": student_uid(lock.domain) if isolation.strict else None})
 
 
+def _record_folder(record: Path | None) -> tuple[Path | None, list[str]]:
+    """The recordings' folder, made and absolute; None and a warning if it cannot be made
+    (the grading goes on without recording)."""
+    if record is None:
+        return None, []
+    try:
+        record = Path(record).resolve()
+        record.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        return None, [_("The run could not be recorded in {path}: {error}").format(
+            path=record, error=exc)]
+    return record, []
+
+
 def _run(exercise: Exercise, submission: Path | None, hidden: bool, lock: DomainLock,
          isolation: Isolation, real_time_factor: float | None,
          progress: Callable[[RawTest], None] | None,
-         started: float) -> tuple[RunResult, RawReport]:
+         started: float, record: Path | None = None) -> tuple[RunResult, RawReport]:
     """One grading in a child pytest on the reserved domain; the result and raw report.
 
     The child gets its :class:`~autograder.core.settings.RunSettings` as one document. It
@@ -82,7 +103,8 @@ def _run(exercise: Exercise, submission: Path | None, hidden: bool, lock: Domain
             submission=str(Path(submission).resolve()) if submission is not None else None,
             course=str(exercise.folder.parent.parent), report=str(report_path),
             key_fd=key_read, lifeline_fd=life_read, domain=lock.domain,
-            real_time_factor=real_time_factor, isolation=isolation.mode, lang=get_language())
+            real_time_factor=real_time_factor, isolation=isolation.mode, lang=get_language(),
+            record=str(record) if record is not None else None)
         command = [
             *run_prefix(isolation), sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
             "--rootdir", str(exercise.folder), "--basetemp", str(Path(tmp) / "pytest"),
@@ -221,4 +243,5 @@ def _result(exercise: Exercise, raw_report: RawReport, returncode: int | None,
         execution_time=elapsed,
         data={"recordings": data.get("recordings", {}), "timed_out": timed_out,
               "startup_seconds": data.get("startup_seconds", []),
-              "pacing": data.get("pacing", {})})
+              "pacing": data.get("pacing", {}), "bags": data.get("bags", {}),
+              "warnings": data.get("warnings", [])})

@@ -62,6 +62,8 @@ def pytest_addoption(parser: pytest.Parser) -> None:
                     help="ROS domain id of this run (default: reserve a free one)")
     group.addoption("--real-time-factor", type=float, default=None,
                     help="override the exercise's real-time factor")
+    group.addoption("--record-bags", default=None, metavar="DIR",
+                    help="record each test module's graph as a rosbag2 bag in DIR/<module>")
     group.addoption("--autograder-settings", default=None,
                     help="the grader's settings for this run (JSON; see "
                          "autograder.core.settings)")
@@ -77,8 +79,13 @@ def _settings(config: pytest.Config) -> RunSettings | None:
                            submission=config.getoption("submission"),
                            domain=config.getoption("ros_domain"),
                            real_time_factor=config.getoption("real_time_factor"),
-                           lang=os.environ.get("AUTOGRADER_LANG", "en"))
+                           lang=os.environ.get("AUTOGRADER_LANG", "en"),
+                           record=_absolute(config.getoption("record_bags")))
     return None
+
+
+def _absolute(path: str | None) -> str | None:
+    return os.path.abspath(path) if path else None
 
 
 def pytest_configure(config: pytest.Config) -> None:

@@ -2,7 +2,9 @@
 
 It publishes, records what it receives stamped with simulation time, calls services and
 sets parameters.  Every wait has a deadline in simulation time and a wall-time cap, so
-a stalled world or a hung node ends a test with a message instead of hanging it.
+a stalled world or a hung node ends a test with a message instead of hanging it.  Taps
+(:meth:`Probe.add_tap`, a bag recorder) get what it receives and publishes, except what
+the world already hands them.
 """
 
 from __future__ import annotations
@@ -22,6 +24,8 @@ from rclpy.qos import QoSProfile, ReliabilityPolicy
 
 from autograder.core.errors import GraderError, StudentFailure
 from autograder.i18n import _
+from sim.bag import Tap
+from sim.msgdefs import type_name
 
 M = TypeVar("M")
 
@@ -124,6 +128,25 @@ class Probe:
         self._thread = threading.Thread(target=self._spin, daemon=True, name="probe-executor")
         self._thread.start()
         self._publishers: dict[str, Any] = {}
+        self._taps: list[Tap] = []
+        self._subscribed: set[str] = set()
+
+    def add_tap(self, tap: Tap) -> None:
+        """Hand ``tap(topic, type name, message, sim time)`` each message this probe receives
+        or publishes, but not twice: not what it receives on the world's own topics (the
+        world's taps see those), nor what it publishes on a topic that the world or this
+        probe subscribes to (seen again on arrival)."""
+        self._taps.append(tap)
+
+    def _tap(self, topic: str, message: Any, stamp: float) -> None:
+        for tap in self._taps:
+            tap(topic, type_name(type(message)), message, stamp)
+
+    def _received(self, topic: str, inbox: Inbox[Any], stamp: float, message: Any) -> None:
+        inbox.add(stamp, message)
+        world = (*getattr(self.world, "PUBLISHES", ()), *getattr(self.world, "SUBSCRIBES", ()))
+        if topic not in world:
+            self._tap(topic, message, stamp)
 
     def _spin(self) -> None:
         try:
@@ -189,15 +212,18 @@ class Probe:
         inbox: Inbox[M] = Inbox(topic)
         qos = QoSProfile(depth=depth, reliability=ReliabilityPolicy.RELIABLE)
         sent_at = getattr(self.world, "sim_time_at", None)
+        name = self.node.resolve_topic_name(topic)
+        self._subscribed.add(name)
         if stamp == "published" and sent_at is not None:
             def record(message: Any, info: dict[str, Any]) -> None:
                 source = info.get("source_timestamp") if isinstance(info, dict) else None
-                inbox.add(min(sent_at(source), self.now) if source else self.now, message)
+                at = min(sent_at(source), self.now) if source else self.now
+                self._received(name, inbox, at, message)
 
             inbox.subscription = self.node.create_subscription(msg_type, topic, record, qos)
         else:
             inbox.subscription = self.node.create_subscription(
-                msg_type, topic, lambda m: inbox.add(self.now, m), qos)
+                msg_type, topic, lambda m: self._received(name, inbox, self.now, m), qos)
         return inbox
 
     def publish(self, msg_type: type, topic: str, message: Any) -> None:
@@ -206,6 +232,9 @@ class Probe:
             publisher = self.node.create_publisher(msg_type, topic, 10)
             self._publishers[topic] = publisher
         publisher.publish(message)
+        name = publisher.topic_name
+        if name not in (*getattr(self.world, "SUBSCRIBES", ()), *self._subscribed):
+            self._tap(name, message, self.now)
 
     def wait_for_subscriber(self, msg_type: type, topic: str, sim_timeout: float = 5.0) -> bool:
         """Wait until someone subscribes to ``topic`` (so our first message is not lost)."""

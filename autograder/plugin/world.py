@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING
 import pytest
 
 from autograder.core.errors import StudentFailure
+from autograder.plugin.bag import attach_probe, close_bag, open_bag
 from autograder.plugin.probe import WORLD_NODE_NAME
 from autograder.plugin.stash import reporter_key, settings_key
 
@@ -94,11 +95,13 @@ def world(request: pytest.FixtureRequest, exercise: Exercise,
                        max_clock_hz=exercise.clock_hz,
                        cpu_budget=exercise.cpu_budget,
                        real_time_factor=exercise.real_time_factor if rtf is None else rtf)
+    bag = open_bag(request, bridge, spec.name)
     bridge.start()
     try:
         yield bridge
     finally:
         bridge.stop()
+        close_bag(request, bag)
         reporter = request.config.stash.get(reporter_key, None)
         if reporter is not None:
             reporter.data["recordings"][request.node.name] = bridge.recording.to_dict()
@@ -107,11 +110,13 @@ def world(request: pytest.FixtureRequest, exercise: Exercise,
 
 
 @pytest.fixture(scope="module")
-def probe(ros_context: Context, world: SimBridge) -> Iterator[Probe]:
+def probe(request: pytest.FixtureRequest, ros_context: Context,
+          world: SimBridge) -> Iterator[Probe]:
     """The grader's own node on the graph: publish, subscribe, call, set parameters."""
     from autograder.plugin.probe import Probe
 
     node = Probe(ros_context, world)
+    attach_probe(request, node)
     try:
         yield node
     finally:
