@@ -17,6 +17,7 @@ from autograder.core.output import TAIL_BYTES, TAIL_LINES, message_tail, size_no
 from autograder.i18n import _
 from autograder.plugin.probe import GRADER_NODES
 from autograder.plugin.stash import reporter_key, settings_key, startup_key
+from autograder.sandbox.graph import node_endpoints, wait_until_up
 
 if TYPE_CHECKING:
     from autograder.core.exercise import Exercise
@@ -151,16 +152,9 @@ class NodeNeverAppeared(StudentFailure):
     """The program ran, but its node never showed up on the graph (not a crash)."""
 
 
-# Every rclpy node publishes on these (its log and its parameter events): the endpoints
-# that tell one instance of a node from another of the same name.
-NODE_TOPICS = ("/rosout", "/parameter_events")
-
-
 def _node_endpoints(probe: Probe, name: str) -> set[bytes]:
-    """The GIDs of the publishers node ``name`` has on NODE_TOPICS, as the graph shows."""
-    return {bytes(info.endpoint_gid) for topic in NODE_TOPICS
-            for info in probe.node.get_publishers_info_by_topic(topic)
-            if info.node_name == name}
+    """The GIDs of the publishers node ``name`` has on the topics every node publishes."""
+    return set(node_endpoints(probe.node, name))
 
 
 def _wait_for_node(exercise: Exercise, node: StudentNode, world: SimBridge,
@@ -168,18 +162,8 @@ def _wait_for_node(exercise: Exercise, node: StudentNode, world: SimBridge,
     """Wait, with simulation time held, until this instance's node is on the graph: a
     start-up is then the same in simulation time however long the machine takes (imports,
     discovery), and the node's first tick is the next one."""
-    deadline = time.monotonic() + exercise.startup_timeout
-    found = False
-
-    def ready() -> bool:
-        nonlocal found
-        # Not the name: an earlier instance's may linger after its endpoints are gone.
-        found = bool(_node_endpoints(node.probe, exercise.node) - stale)
-        return found or not node.running() or time.monotonic() > deadline
-
-    with world.held():
-        world.wait_for(ready, sim_timeout=float("inf"),
-                       wall_timeout=exercise.startup_timeout + 1)
+    found = wait_until_up(world, node.probe.node, exercise.node, stale, node.running,
+                          exercise.startup_timeout)
     if found:
         node.startup_seconds = time.monotonic() - node.process.started_at
         return
