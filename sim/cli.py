@@ -39,9 +39,10 @@ def sim_cli() -> None:
 @sim_cli.command("worlds")
 def worlds_command() -> None:
     """List the shipped worlds."""
-    for name in world_names():
-        spec = _load(name)
-        click.echo(f"{name:<12} {title_of(spec)}")
+    names = world_names()
+    width = max((len(name) for name in names), default=0)
+    for name in names:
+        click.echo(f"{name:<{width}}  {title_of(_load(name))}")
 
 
 @sim_cli.command("check")
@@ -73,10 +74,12 @@ def check_command(file: Path) -> None:
 def run_command(world_name: str, rtf: float, duration: float | None, domain: int | None,
                 record: Path | None, svg: Path | None, seed: int | None,
                 clock_hz: float) -> None:
-    """Run a world on a ROS domain so a node started by hand can drive the robot.
+    """Run a world on a ROS domain so a node can drive the robot.
 
-    Start your node in another terminal with the same ROS_DOMAIN_ID and
-    ``--ros-args -p use_sim_time:=true``.
+    Start your node in another terminal with the same ROS_DOMAIN_ID:
+
+    \b
+        python my_node.py --ros-args -p use_sim_time:=true
     """
     spec = _load(world_name)
     domain = int(os.environ.get("ROS_DOMAIN_ID", "0")) if domain is None else domain
