@@ -1,4 +1,4 @@
-"""``autograder sim``: run a world standalone, list worlds, check a world file.
+"""``autograder sim``: run a world standalone, list worlds, check a world file, drive.
 
 A thin click layer: each command calls plain functions of the ``sim`` package.
 """
@@ -14,6 +14,7 @@ import click
 
 from sim.content import ContentError
 from sim.i18n import _
+from sim.keyboard import Command
 from sim.pacing import DEFAULT_CLOCK_HZ
 from sim.worldfile import load_world, title_of, world_names, world_path
 
@@ -82,10 +83,13 @@ def run_command(world_name: str, rtf: float, duration: float | None, domain: int
         python my_node.py --ros-args -p use_sim_time:=true
     """
     spec = _load(world_name)
-    domain = int(os.environ.get("ROS_DOMAIN_ID", "0")) if domain is None else domain
-    summary = run_world(spec, rtf=rtf, duration=duration, domain=domain, seed=seed,
+    summary = run_world(spec, rtf=rtf, duration=duration, domain=_domain(domain), seed=seed,
                         record=record, svg=svg, clock_hz=clock_hz)
     click.echo(summary)
+
+
+def _domain(given: int | None) -> int:
+    return int(os.environ.get("ROS_DOMAIN_ID", "0")) if given is None else given
 
 
 def run_world(spec, *, rtf: float, duration: float | None, domain: int,  # noqa: ANN001
@@ -120,6 +124,105 @@ def run_world(spec, *, rtf: float, duration: float | None, domain: int,  # noqa:
     if svg:
         svg.write_text(trajectory_svg(spec, recording), encoding="utf-8")
     return _summary(spec, bridge, effective)
+
+
+class NoTerminal(click.ClickException):
+    """``--keys`` without a terminal to read them from (exit code 2, a usage error)."""
+
+    exit_code = 2
+
+
+@sim_cli.command("drive")
+@click.option("--topic", default="/cmd_vel", show_default=True,
+              help="Topic the velocity commands go to.")
+@click.option("--linear", type=float, default=0.0, show_default=True,
+              help="Forward velocity in m/s.")
+@click.option("--angular", type=float, default=0.0, show_default=True,
+              help="Turn rate in rad/s (positive: counter-clockwise).")
+@click.option("--for", "seconds", type=click.FloatRange(min=0.0, min_open=True), default=None,
+              help="Drive this many seconds, then stop (default: until Ctrl-C).")
+@click.option("--rate", type=click.FloatRange(min=0.1, max=1000.0), default=10.0,
+              show_default=True, help="Commands per second.")
+@click.option("--stamped", is_flag=True,
+              help="Publish geometry_msgs/TwistStamped instead of Twist.")
+@click.option("--keys", is_flag=True,
+              help="Drive with the keyboard: w/x or up/down arrows faster/slower, a/d or "
+                   "left/right arrows turn, s or space stop, q quit.")
+@click.option("--domain", type=click.IntRange(0, 232), default=None,
+              help="ROS domain id (default: $ROS_DOMAIN_ID or 0).")
+def drive_command(topic: str, linear: float, angular: float, seconds: float | None,
+                  rate: float, stamped: bool, keys: bool, domain: int | None) -> None:
+    """Publish velocity commands, so you can try a node without writing a publisher.
+
+    Commands go out on simulation time when a world is running (its /clock is on the
+    graph), else on wall time, and end with a zero command. Start the world first.
+    """
+    import sys
+
+    if keys and not sys.stdin.isatty():
+        raise NoTerminal(_("--keys needs a terminal: standard input is not one."))
+    drive(topic, Command(linear, angular), seconds=seconds, rate=rate, stamped=stamped,
+          keys=keys, domain=_domain(domain))
+
+
+def drive(topic: str, command: Command, *, seconds: float | None, rate: float = 10.0,
+          stamped: bool = False, keys: bool = False, domain: int = 0) -> None:
+    """Publish ``command`` (with ``keys``, the keyboard's) on ``topic`` for ``seconds`` or
+    until Ctrl-C, then a zero command."""
+    import rclpy
+    from rclpy.context import Context
+
+    from sim.drive import Driver
+
+    ctx = Context()
+    rclpy.init(context=ctx, domain_id=domain)
+    driver = None
+    try:
+        driver = Driver(ctx, topic, rate=rate, stamped=stamped)
+        clock = (_("Driving on {topic} in simulation time (a world's /clock is on the graph).")
+                 if driver.sim_time else
+                 _("Driving on {topic} in wall time (no /clock on the graph)."))
+        click.echo(clock.format(topic=topic), err=True)
+        if not driver.subscribed:
+            click.echo(_("Nobody subscribes to {topic} yet; publishing anyway.").format(
+                topic=topic), err=True)
+        if keys:
+            _drive_by_keys(driver, seconds)
+        else:
+            driver.begin(command, seconds)
+            driver.run()
+    except KeyboardInterrupt:
+        pass
+    finally:
+        if driver is not None:
+            elapsed = driver.elapsed
+            driver.close()
+            click.echo(_("Stopped after {seconds:.2f} s with a zero command on {topic}.").format(
+                seconds=elapsed, topic=topic), err=True)
+        rclpy.try_shutdown(context=ctx)
+
+
+def _drive_by_keys(driver, seconds: float | None) -> None:  # noqa: ANN001 - sim.drive.Driver
+    import sys
+
+    from sim.keyboard import apply_key, raw_terminal, read_keys
+
+    click.echo(_("Keys: w or up arrow faster, x or down arrow slower, a or left arrow turn "
+                 "left, d or right arrow turn right, s or space stop, q quit."), err=True)
+    fd = sys.stdin.fileno()
+    driver.begin(Command(), seconds)
+    with raw_terminal(fd):
+        while not driver.done:
+            for key in read_keys(fd, 0.02):
+                command = apply_key(driver.command, key)
+                if command is None:
+                    return
+                driver.command = command
+                click.echo("\r" + _("linear {linear:+.2f} m/s, angular {angular:+.2f} "
+                                     "rad/s").format(linear=command.linear,
+                                                     angular=command.angular) + "   ",
+                           nl=False, err=True)
+            driver.spin_once(0.0)
 
 
 def _summary(spec, bridge, effective: float) -> str:  # noqa: ANN001
