@@ -1,6 +1,9 @@
 """``autograder sim``: run a world standalone, list worlds, check a world file, drive.
 
-A thin click layer: each command calls plain functions of the ``sim`` package.
+A thin click layer: each command calls plain functions of the ``sim`` package. ``sim run``
+can also start a program with the world (a :class:`Companion`, put in the click context's
+``meta`` under :data:`COMPANION`): ``autograder sim run --node`` starts a student's node
+that way, while ``sim`` itself knows nothing of the autograder.
 """
 
 from __future__ import annotations
@@ -9,6 +12,7 @@ import json
 import math
 import os
 from pathlib import Path
+from typing import TYPE_CHECKING, Any, Protocol
 
 import click
 
@@ -17,6 +21,33 @@ from sim.i18n import _
 from sim.keyboard import Command
 from sim.pacing import DEFAULT_CLOCK_HZ
 from sim.worldfile import load_world, title_of, world_names, world_path
+
+if TYPE_CHECKING:
+    from sim.bridge import SimBridge
+
+COMPANION = "sim.run.companion"
+"""Key of the :class:`Companion` ``sim run`` starts with the world, in ``ctx.meta``."""
+
+
+class Companion(Protocol):
+    """A program run with the world: started once the world exists, with simulation time
+    held until it is up, and stopped before the world."""
+
+    def bridge_options(self) -> dict[str, Any]:
+        """Keyword arguments for :class:`sim.bridge.SimBridge` (``cpu_budget``, ...)."""
+        ...
+
+    def start(self, bridge: SimBridge) -> None:
+        """Start, and return once up (no tick goes meanwhile)."""
+        ...
+
+    def running(self) -> bool:
+        """Whether it still runs (the world stops when it ends)."""
+        ...
+
+    def stop(self) -> list[str]:
+        """Stop everything it started; lines for the run's summary."""
+        ...
 
 
 class WorldFileError(click.ClickException):
@@ -84,7 +115,8 @@ def run_command(world_name: str, rtf: float, duration: float | None, domain: int
     """
     spec = _load(world_name)
     summary = run_world(spec, rtf=rtf, duration=duration, domain=_domain(domain), seed=seed,
-                        record=record, svg=svg, clock_hz=clock_hz)
+                        record=record, svg=svg, clock_hz=clock_hz,
+                        companion=click.get_current_context().meta.get(COMPANION))
     click.echo(summary)
 
 
@@ -94,8 +126,10 @@ def _domain(given: int | None) -> int:
 
 def run_world(spec, *, rtf: float, duration: float | None, domain: int,  # noqa: ANN001
               seed: int | None = None, record: Path | None = None,
-              svg: Path | None = None, clock_hz: float = DEFAULT_CLOCK_HZ) -> str:
-    """Run ``spec`` on ``domain`` until ``duration`` sim seconds or Ctrl-C; return a summary."""
+              svg: Path | None = None, clock_hz: float = DEFAULT_CLOCK_HZ,
+              companion: Companion | None = None) -> str:
+    """Run ``spec`` on ``domain`` until ``duration`` sim seconds, Ctrl-C, or the end of
+    ``companion`` (started with simulation time held until it is up); return a summary."""
     import rclpy
     from rclpy.context import Context
 
@@ -105,25 +139,42 @@ def run_world(spec, *, rtf: float, duration: float | None, domain: int,  # noqa:
 
     ctx = Context()
     rclpy.init(context=ctx, domain_id=domain)
-    bridge = SimBridge(World(spec, seed=seed), ctx, real_time_factor=rtf, max_clock_hz=clock_hz)
+    bridge = SimBridge(World(spec, seed=seed), ctx, real_time_factor=rtf, max_clock_hz=clock_hz,
+                       **(companion.bridge_options() if companion is not None else {}))
     click.echo(_("World {name} on ROS domain {domain}, RTF {rtf}. Ctrl-C stops.").format(
         name=spec.name, domain=domain, rtf=rtf or _("max")))
-    bridge.start()
+    notes: list[str] = []
     try:
-        while duration is None or bridge.now < duration:
-            bridge.wait_until(duration if duration is not None else math.inf, 0.5)
+        if companion is not None:
+            bridge.pause()  # simulation time starts only once the companion is up
+        bridge.start()
+        if companion is not None:
+            companion.start(bridge)
+            bridge.resume()
+
+        def over() -> bool:
+            return ((duration is not None and bridge.now >= duration - 1e-9)
+                    or (companion is not None and not companion.running()))
+
+        while not over():
+            bridge.wait_for(over, sim_timeout=math.inf, wall_timeout=0.5)
     except KeyboardInterrupt:
         pass
     finally:
-        effective = bridge.effective_rtf
-        bridge.stop()
-        rclpy.try_shutdown(context=ctx)
+        try:
+            if companion is not None:
+                bridge.pause()  # the world ends where the run did, not while it stops
+                notes = companion.stop()
+        finally:
+            effective = bridge.effective_rtf
+            bridge.stop()
+            rclpy.try_shutdown(context=ctx)
     recording = bridge.recording
     if record:
         record.write_text(json.dumps(recording.to_dict(), indent=1), encoding="utf-8")
     if svg:
         svg.write_text(trajectory_svg(spec, recording), encoding="utf-8")
-    return _summary(spec, bridge, effective)
+    return "\n".join([*notes, _summary(spec, bridge, effective)])
 
 
 class NoTerminal(click.ClickException):
@@ -244,4 +295,4 @@ def _summary(spec, bridge, effective: float) -> str:  # noqa: ANN001
     return "\n".join(lines)
 
 
-__all__ = ["sim_cli", "run_world", "world_path"]
+__all__ = ["COMPANION", "Companion", "sim_cli", "run_world", "world_path"]

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any
 import pytest
 
 from autograder.core.errors import StudentFailure
-from autograder.core.output import TAIL_BYTES, TAIL_LINES, message_tail, size_note
+from autograder.core.output import TAIL_BYTES, TAIL_LINES, describe_exit, message_tail, size_note
 from autograder.i18n import _
 from autograder.plugin.probe import GRADER_NODES
 from autograder.plugin.stash import reporter_key, settings_key, startup_key
@@ -74,17 +74,6 @@ class StudentNode:
             on_stop, self.on_stop = self.on_stop, None
             on_stop(self)
         return status
-
-
-def _describe_exit(code: int) -> str:
-    if code < 0:
-        import signal
-
-        try:
-            return _("was killed by signal {name}").format(name=signal.Signals(-code).name)
-        except ValueError:
-            return _("was killed by signal {number}").format(number=-code)
-    return _("exited with status {code}").format(code=code)
 
 
 def launch(request: pytest.FixtureRequest, exercise: Exercise, script: Path, probe: Probe,
@@ -190,7 +179,7 @@ def _exited_at_start(node: StudentNode, exercise: Exercise) -> StudentFailure:
     node.stop()  # drains the pipe, so the tail ends with its last words
     message = _("Your program {how} during start-up, before its node '{node}' was up and "
                 "spinning.\nLast lines of its output:\n{tail}").format(
-        how=_describe_exit(code if code is not None else 0), node=exercise.node,
+        how=describe_exit(code if code is not None else 0), node=exercise.node,
         tail=node.output_tail() or _("(no output)"))
     if code == 0:
         return StudentFailure(message, _("Call `rclpy.spin(node)` (or an executor's "

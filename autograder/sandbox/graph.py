@@ -18,6 +18,8 @@ from typing import Protocol
 # Every rclpy node publishes on these (its log and its parameter events): the endpoints
 # that tell one instance of a node from another of the same name.
 NODE_TOPICS = ("/rosout", "/parameter_events")
+# The name the graph gives an endpoint before its node's name is known.
+UNKNOWN_NODE = "_NODE_NAME_UNKNOWN_"
 
 
 class Graph(Protocol):
@@ -37,11 +39,11 @@ class HeldWorld(Protocol):
 
 
 def node_endpoints(graph: Graph, name: str | None) -> dict[bytes, str]:
-    """The publishers node ``name`` (any node: None) has on NODE_TOPICS, as the graph shows
-    them: endpoint GID to node name."""
+    """The publishers node ``name`` (any node whose name is known: None) has on NODE_TOPICS,
+    as the graph shows them: endpoint GID to node name."""
     return {bytes(info.endpoint_gid): info.node_name for topic in NODE_TOPICS
             for info in graph.get_publishers_info_by_topic(topic)
-            if name is None or info.node_name == name}
+            if info.node_name == name or name is None and info.node_name != UNKNOWN_NODE}
 
 
 def wait_until_up(world: HeldWorld, graph: Graph, name: str | None, stale: Iterable[bytes],
