@@ -262,18 +262,21 @@ def _drive_by_keys(driver, seconds: float | None) -> None:  # noqa: ANN001 - sim
                  "left, d or right arrow turn right, s or space stop, q quit."), err=True)
     fd = sys.stdin.fileno()
     driver.begin(Command(), seconds)
-    with raw_terminal(fd):
-        while not driver.done:
-            for key in read_keys(fd, 0.02):
-                command = apply_key(driver.command, key)
-                if command is None:
-                    return
-                driver.command = command
-                click.echo("\r" + _("linear {linear:+.2f} m/s, angular {angular:+.2f} "
-                                     "rad/s").format(linear=command.linear,
-                                                     angular=command.angular) + "   ",
-                           nl=False, err=True)
-            driver.spin_once(0.0)
+    try:
+        with raw_terminal(fd):
+            while not driver.done:
+                for key in read_keys(fd, 0.02):
+                    command = apply_key(driver.command, key)
+                    if command is None:
+                        return
+                    driver.command = command
+                    click.echo("\r" + _("linear {linear:+.2f} m/s, angular {angular:+.2f} "
+                                         "rad/s").format(linear=command.linear,
+                                                         angular=command.angular) + "   ",
+                               nl=False, err=True)
+                driver.spin_once(0.0)
+    finally:
+        click.echo(err=True)  # off the status line
 
 
 def _summary(spec, bridge, effective: float) -> str:  # noqa: ANN001
