@@ -46,6 +46,15 @@ def test_exercise_goes_with_node() -> None:
     assert "--exercise goes with --node" in result.output
 
 
+def test_a_syntax_error_is_said_before_the_world_starts(tmp_path: Path) -> None:
+    broken = tmp_path / "my_node.py"
+    broken.write_text("import rclpy\n\ndef main(:\n    pass\n")
+    result = CliRunner().invoke(main, ["sim", "run", "--node", str(broken)])
+    assert result.exit_code == 1
+    assert "my_node.py, line 3:" in result.output
+    assert "World" not in result.output
+
+
 def _command(domain: int, *args: str) -> list[str]:
     return [sys.executable, "-c", "from autograder.cli import main; main()", "sim", "run",
             "--domain", str(domain), *args]

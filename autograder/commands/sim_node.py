@@ -82,7 +82,6 @@ class NodeRun:
         from autograder.sandbox.graph import node_endpoints, wait_until_up
         from autograder.sandbox.process import LaunchFailed, student_process
 
-        _check_syntax(self.script)
         self._bridge = bridge
         self._folder = Path(tempfile.mkdtemp(prefix="autograder-hand-"))
         name = self.exercise.file if self.exercise is not None else self.script.name
@@ -221,6 +220,7 @@ def add_node_options(run: click.Command) -> None:
             if exercise is not None:
                 raise click.UsageError(_("--exercise goes with --node FILE."))
             return original(**kwargs)
+        _check_syntax(node_file)  # before the world: nothing to watch
         found = node_exercise(node_file, exercise)
         if found is not None:
             click.echo(_("Running {file} as the node '{node}' of exercise {exercise}.").format(
