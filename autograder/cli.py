@@ -15,6 +15,7 @@ import click
 
 from autograder import __version__
 from autograder.commands.exits import GraderFault, UsageProblem, report_problems
+from autograder.commands.sim_node import add_node_options
 from autograder.core.errors import ContentError
 from autograder.i18n import LANGUAGES, _, get_language, set_language
 from autograder.i18n.cli import i18n_cli
@@ -409,6 +410,7 @@ def validate(run_gradings: bool, jobs: int, course: Path | None) -> None:
     click.echo(_("The course is valid."))
 
 
+add_node_options(sim_cli.commands["run"])  # sim knows nothing of students' nodes
 main.add_command(sim_cli, "sim")
 main.add_command(quiz_cli, "quiz")
 main.add_command(i18n_cli, "i18n")

@@ -1,6 +1,9 @@
-"""``autograder sim``: run a world standalone, list worlds, check a world file.
+"""``autograder sim``: run a world standalone, list worlds, check a world file, drive.
 
-A thin click layer: each command calls plain functions of the ``sim`` package.
+A thin click layer: each command calls plain functions of the ``sim`` package. ``sim run``
+can also start a program with the world (a :class:`Companion`, put in the click context's
+``meta`` under :data:`COMPANION`): ``autograder sim run --node`` starts a student's node
+that way, while ``sim`` itself knows nothing of the autograder.
 """
 
 from __future__ import annotations
@@ -9,13 +12,42 @@ import json
 import math
 import os
 from pathlib import Path
+from typing import TYPE_CHECKING, Any, Protocol
 
 import click
 
 from sim.content import ContentError
 from sim.i18n import _
+from sim.keyboard import Command
 from sim.pacing import DEFAULT_CLOCK_HZ
 from sim.worldfile import load_world, title_of, world_names, world_path
+
+if TYPE_CHECKING:
+    from sim.bridge import SimBridge
+
+COMPANION = "sim.run.companion"
+"""Key of the :class:`Companion` ``sim run`` starts with the world, in ``ctx.meta``."""
+
+
+class Companion(Protocol):
+    """A program run with the world: started once the world exists, with simulation time
+    held until it is up, and stopped before the world."""
+
+    def bridge_options(self) -> dict[str, Any]:
+        """Keyword arguments for :class:`sim.bridge.SimBridge` (``cpu_budget``, ...)."""
+        ...
+
+    def start(self, bridge: SimBridge) -> None:
+        """Start, and return once up (no tick goes meanwhile)."""
+        ...
+
+    def running(self) -> bool:
+        """Whether it still runs (the world stops when it ends)."""
+        ...
+
+    def stop(self) -> list[str]:
+        """Stop everything it started; lines for the run's summary."""
+        ...
 
 
 class WorldFileError(click.ClickException):
@@ -39,9 +71,10 @@ def sim_cli() -> None:
 @sim_cli.command("worlds")
 def worlds_command() -> None:
     """List the shipped worlds."""
-    for name in world_names():
-        spec = _load(name)
-        click.echo(f"{name:<12} {title_of(spec)}")
+    names = world_names()
+    width = max((len(name) for name in names), default=0)
+    for name in names:
+        click.echo(f"{name:<{width}}  {title_of(_load(name))}")
 
 
 @sim_cli.command("check")
@@ -75,23 +108,30 @@ def check_command(file: Path) -> None:
 def run_command(world_name: str, rtf: float, duration: float | None, domain: int | None,
                 record: Path | None, svg: Path | None, bag: Path | None, seed: int | None,
                 clock_hz: float) -> None:
-    """Run a world on a ROS domain so a node started by hand can drive the robot.
+    """Run a world on a ROS domain so a node can drive the robot.
 
-    Start your node in another terminal with the same ROS_DOMAIN_ID and
-    ``--ros-args -p use_sim_time:=true``.
+    Start your node in another terminal with the same ROS_DOMAIN_ID:
+
+    \b
+        python my_node.py --ros-args -p use_sim_time:=true
     """
     spec = _load(world_name)
-    domain = int(os.environ.get("ROS_DOMAIN_ID", "0")) if domain is None else domain
-    summary = run_world(spec, rtf=rtf, duration=duration, domain=domain, seed=seed,
-                        record=record, svg=svg, clock_hz=clock_hz, bag=bag)
+    summary = run_world(spec, rtf=rtf, duration=duration, domain=_domain(domain), seed=seed,
+                        record=record, svg=svg, clock_hz=clock_hz, bag=bag,
+                        companion=click.get_current_context().meta.get(COMPANION))
     click.echo(summary)
+
+
+def _domain(given: int | None) -> int:
+    return int(os.environ.get("ROS_DOMAIN_ID", "0")) if given is None else given
 
 
 def run_world(spec, *, rtf: float, duration: float | None, domain: int,  # noqa: ANN001
               seed: int | None = None, record: Path | None = None,
               svg: Path | None = None, clock_hz: float = DEFAULT_CLOCK_HZ,
-              bag: Path | None = None) -> str:
-    """Run ``spec`` on ``domain`` until ``duration`` sim seconds or Ctrl-C; return a summary.
+              bag: Path | None = None, companion: Companion | None = None) -> str:
+    """Run ``spec`` on ``domain`` until ``duration`` sim seconds, Ctrl-C, or the end of
+    ``companion`` (started with simulation time held until it is up); return a summary.
     With ``bag``, the world's topics are recorded there as a rosbag2 bag."""
     import rclpy
     from rclpy.context import Context
@@ -102,20 +142,37 @@ def run_world(spec, *, rtf: float, duration: float | None, domain: int,  # noqa:
 
     ctx = Context()
     rclpy.init(context=ctx, domain_id=domain)
-    bridge = SimBridge(World(spec, seed=seed), ctx, real_time_factor=rtf, max_clock_hz=clock_hz)
+    bridge = SimBridge(World(spec, seed=seed), ctx, real_time_factor=rtf, max_clock_hz=clock_hz,
+                       **(companion.bridge_options() if companion is not None else {}))
     recorder = _recorder(bag, bridge, spec.name) if bag else None
     click.echo(_("World {name} on ROS domain {domain}, RTF {rtf}. Ctrl-C stops.").format(
         name=spec.name, domain=domain, rtf=rtf or _("max")))
-    bridge.start()
+    notes: list[str] = []
     try:
-        while duration is None or bridge.now < duration:
-            bridge.wait_until(duration if duration is not None else math.inf, 0.5)
+        if companion is not None:
+            bridge.pause()  # simulation time starts only once the companion is up
+        bridge.start()
+        if companion is not None:
+            companion.start(bridge)
+            bridge.resume()
+
+        def over() -> bool:
+            return ((duration is not None and bridge.now >= duration - 1e-9)
+                    or (companion is not None and not companion.running()))
+
+        while not over():
+            bridge.wait_for(over, sim_timeout=math.inf, wall_timeout=0.5)
     except KeyboardInterrupt:
         pass
     finally:
-        effective = bridge.effective_rtf
-        bridge.stop()
-        rclpy.try_shutdown(context=ctx)
+        try:
+            if companion is not None:
+                bridge.pause()  # the world ends where the run did, not while it stops
+                notes = companion.stop()
+        finally:
+            effective = bridge.effective_rtf
+            bridge.stop()
+            rclpy.try_shutdown(context=ctx)
     if recorder is not None:
         written = recorder.close()
         for warning in recorder.warnings():
@@ -128,7 +185,109 @@ def run_world(spec, *, rtf: float, duration: float | None, domain: int,  # noqa:
         record.write_text(json.dumps(recording.to_dict(), indent=1), encoding="utf-8")
     if svg:
         svg.write_text(trajectory_svg(spec, recording), encoding="utf-8")
-    return _summary(spec, bridge, effective)
+    return "\n".join([*notes, _summary(spec, bridge, effective)])
+
+
+class NoTerminal(click.ClickException):
+    """``--keys`` without a terminal to read them from (exit code 2, a usage error)."""
+
+    exit_code = 2
+
+
+@sim_cli.command("drive")
+@click.option("--topic", default="/cmd_vel", show_default=True,
+              help="Topic the velocity commands go to.")
+@click.option("--linear", type=float, default=0.0, show_default=True,
+              help="Forward velocity in m/s.")
+@click.option("--angular", type=float, default=0.0, show_default=True,
+              help="Turn rate in rad/s (positive: counter-clockwise).")
+@click.option("--for", "seconds", type=click.FloatRange(min=0.0, min_open=True), default=None,
+              help="Drive this many seconds, then stop (default: until Ctrl-C).")
+@click.option("--rate", type=click.FloatRange(min=0.1, max=1000.0), default=10.0,
+              show_default=True, help="Commands per second.")
+@click.option("--stamped", is_flag=True,
+              help="Publish geometry_msgs/TwistStamped instead of Twist.")
+@click.option("--keys", is_flag=True,
+              help="Drive with the keyboard: w/x or up/down arrows faster/slower, a/d or "
+                   "left/right arrows turn, s or space stop, q quit.")
+@click.option("--domain", type=click.IntRange(0, 232), default=None,
+              help="ROS domain id (default: $ROS_DOMAIN_ID or 0).")
+def drive_command(topic: str, linear: float, angular: float, seconds: float | None,
+                  rate: float, stamped: bool, keys: bool, domain: int | None) -> None:
+    """Publish velocity commands, so you can try a node without writing a publisher.
+
+    Commands go out on simulation time when a world is running (its /clock is on the
+    graph), else on wall time, and end with a zero command. Start the world first.
+    """
+    import sys
+
+    if keys and not sys.stdin.isatty():
+        raise NoTerminal(_("--keys needs a terminal: standard input is not one."))
+    drive(topic, Command(linear, angular), seconds=seconds, rate=rate, stamped=stamped,
+          keys=keys, domain=_domain(domain))
+
+
+def drive(topic: str, command: Command, *, seconds: float | None, rate: float = 10.0,
+          stamped: bool = False, keys: bool = False, domain: int = 0) -> None:
+    """Publish ``command`` (with ``keys``, the keyboard's) on ``topic`` for ``seconds`` or
+    until Ctrl-C, then a zero command."""
+    import rclpy
+    from rclpy.context import Context
+
+    from sim.drive import Driver
+
+    ctx = Context()
+    rclpy.init(context=ctx, domain_id=domain)
+    driver = None
+    try:
+        driver = Driver(ctx, topic, rate=rate, stamped=stamped)
+        clock = (_("Driving on {topic} in simulation time (a world's /clock is on the graph).")
+                 if driver.sim_time else
+                 _("Driving on {topic} in wall time (no /clock on the graph)."))
+        click.echo(clock.format(topic=topic), err=True)
+        if not driver.subscribed:
+            click.echo(_("Nobody subscribes to {topic} yet; publishing anyway.").format(
+                topic=topic), err=True)
+        if keys:
+            _drive_by_keys(driver, seconds)
+        else:
+            driver.begin(command, seconds)
+            driver.run()
+    except KeyboardInterrupt:
+        pass
+    finally:
+        if driver is not None:
+            elapsed = driver.elapsed
+            driver.close()
+            click.echo(_("Stopped after {seconds:.2f} s with a zero command on {topic}.").format(
+                seconds=elapsed, topic=topic), err=True)
+        rclpy.try_shutdown(context=ctx)
+
+
+def _drive_by_keys(driver, seconds: float | None) -> None:  # noqa: ANN001 - sim.drive.Driver
+    import sys
+
+    from sim.keyboard import apply_key, raw_terminal, read_keys
+
+    click.echo(_("Keys: w or up arrow faster, x or down arrow slower, a or left arrow turn "
+                 "left, d or right arrow turn right, s or space stop, q quit."), err=True)
+    fd = sys.stdin.fileno()
+    driver.begin(Command(), seconds)
+    try:
+        with raw_terminal(fd):
+            while not driver.done:
+                for key in read_keys(fd, 0.02):
+                    command = apply_key(driver.command, key)
+                    if command is None:
+                        return
+                    driver.command = command
+                    click.echo("\r" + _("linear {linear:+.2f} m/s, angular {angular:+.2f} "
+                                         "rad/s").format(linear=command.linear,
+                                                         angular=command.angular) + "   ",
+                               nl=False, err=True)
+                driver.spin_once(0.0)
+    finally:
+        click.echo(err=True)  # off the status line
 
 
 def _recorder(folder: Path, bridge, world: str):  # noqa: ANN001, ANN202 - SimBridge, BagRecorder
@@ -166,4 +325,4 @@ def _summary(spec, bridge, effective: float) -> str:  # noqa: ANN001
     return "\n".join(lines)
 
 
-__all__ = ["sim_cli", "run_world", "world_path"]
+__all__ = ["COMPANION", "Companion", "sim_cli", "run_world", "world_path"]

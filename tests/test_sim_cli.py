@@ -17,6 +17,14 @@ def test_worlds_lists_shipped_worlds() -> None:
     assert "corridor" in result.output and "wall_ahead" in result.output
 
 
+def test_worlds_titles_start_in_one_column_whatever_the_names_length() -> None:
+    lines = CliRunner().invoke(sim_cli, ["worlds"]).output.splitlines()
+    names = [line.split()[0] for line in lines]
+    assert "obstacle_course" in names  # longer than the others
+    title_columns = {len(line) - len(line.split(maxsplit=1)[1]) for line in lines}
+    assert title_columns == {max(map(len, names)) + 2}
+
+
 def test_check_good_and_bad(tmp_path: Path) -> None:
     good = CliRunner().invoke(sim_cli, ["check", "sim/worlds/obstacles.yaml"])
     assert good.exit_code == 0 and "ok" in good.output

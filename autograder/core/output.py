@@ -96,3 +96,15 @@ def log_beside(results: Path) -> Path:
 
 def digest(raw: bytes) -> str:
     return hashlib.sha256(raw).hexdigest()
+
+
+def describe_exit(code: int) -> str:
+    """How a program ended, from its exit status (negative: the signal that killed it)."""
+    if code < 0:
+        import signal
+
+        try:
+            return _("was killed by signal {name}").format(name=signal.Signals(-code).name)
+        except ValueError:
+            return _("was killed by signal {number}").format(number=-code)
+    return _("exited with status {code}").format(code=code)

@@ -13,10 +13,11 @@ from typing import TYPE_CHECKING, Any
 import pytest
 
 from autograder.core.errors import StudentFailure
-from autograder.core.output import TAIL_BYTES, TAIL_LINES, message_tail, size_note
+from autograder.core.output import TAIL_BYTES, TAIL_LINES, describe_exit, message_tail, size_note
 from autograder.i18n import _
 from autograder.plugin.probe import GRADER_NODES
 from autograder.plugin.stash import reporter_key, settings_key, startup_key
+from autograder.sandbox.graph import node_endpoints, wait_until_up
 
 if TYPE_CHECKING:
     from autograder.core.exercise import Exercise
@@ -73,17 +74,6 @@ class StudentNode:
             on_stop, self.on_stop = self.on_stop, None
             on_stop(self)
         return status
-
-
-def _describe_exit(code: int) -> str:
-    if code < 0:
-        import signal
-
-        try:
-            return _("was killed by signal {name}").format(name=signal.Signals(-code).name)
-        except ValueError:
-            return _("was killed by signal {number}").format(number=-code)
-    return _("exited with status {code}").format(code=code)
 
 
 def launch(request: pytest.FixtureRequest, exercise: Exercise, script: Path, probe: Probe,
@@ -151,16 +141,9 @@ class NodeNeverAppeared(StudentFailure):
     """The program ran, but its node never showed up on the graph (not a crash)."""
 
 
-# Every rclpy node publishes on these (its log and its parameter events): the endpoints
-# that tell one instance of a node from another of the same name.
-NODE_TOPICS = ("/rosout", "/parameter_events")
-
-
 def _node_endpoints(probe: Probe, name: str) -> set[bytes]:
-    """The GIDs of the publishers node ``name`` has on NODE_TOPICS, as the graph shows."""
-    return {bytes(info.endpoint_gid) for topic in NODE_TOPICS
-            for info in probe.node.get_publishers_info_by_topic(topic)
-            if info.node_name == name}
+    """The GIDs of the publishers node ``name`` has on the topics every node publishes."""
+    return set(node_endpoints(probe.node, name))
 
 
 def _wait_for_node(exercise: Exercise, node: StudentNode, world: SimBridge,
@@ -168,18 +151,8 @@ def _wait_for_node(exercise: Exercise, node: StudentNode, world: SimBridge,
     """Wait, with simulation time held, until this instance's node is on the graph: a
     start-up is then the same in simulation time however long the machine takes (imports,
     discovery), and the node's first tick is the next one."""
-    deadline = time.monotonic() + exercise.startup_timeout
-    found = False
-
-    def ready() -> bool:
-        nonlocal found
-        # Not the name: an earlier instance's may linger after its endpoints are gone.
-        found = bool(_node_endpoints(node.probe, exercise.node) - stale)
-        return found or not node.running() or time.monotonic() > deadline
-
-    with world.held():
-        world.wait_for(ready, sim_timeout=float("inf"),
-                       wall_timeout=exercise.startup_timeout + 1)
+    found = wait_until_up(world, node.probe.node, exercise.node, stale, node.running,
+                          exercise.startup_timeout)
     if found:
         node.startup_seconds = time.monotonic() - node.process.started_at
         return
@@ -206,7 +179,7 @@ def _exited_at_start(node: StudentNode, exercise: Exercise) -> StudentFailure:
     node.stop()  # drains the pipe, so the tail ends with its last words
     message = _("Your program {how} during start-up, before its node '{node}' was up and "
                 "spinning.\nLast lines of its output:\n{tail}").format(
-        how=_describe_exit(code if code is not None else 0), node=exercise.node,
+        how=describe_exit(code if code is not None else 0), node=exercise.node,
         tail=node.output_tail() or _("(no output)"))
     if code == 0:
         return StudentFailure(message, _("Call `rclpy.spin(node)` (or an executor's "

@@ -179,6 +179,8 @@ class StudentProcess:
     # Called as soon as the launcher's process exists, before it is contained: whoever
     # must reap it if the grader dies can know it from the start.
     on_spawn: Callable[[], None] | None = None
+    # Also given every chunk of output as it comes (a hand run streams it to the terminal).
+    echo: Callable[[bytes], None] | None = None
     _reader: threading.Thread | None = None
     _watchdog: threading.Timer | None = None
 
@@ -235,6 +237,8 @@ class StudentProcess:
         stream = self.popen.stdout
         while chunk := stream.read1(65536):
             self.output.feed(chunk)
+            if self.echo is not None:
+                self.echo(chunk)
 
     @property
     def pid(self) -> int:

@@ -1,0 +1,235 @@
+"""``autograder sim run --node FILE``: a student's node started with the world the way
+grading starts it, so that two hand runs of one node in one world are the same run.
+
+The node runs through the sandbox (:func:`autograder.sandbox.process.student_process`:
+a throwaway copy, a minimal environment, ``--ros-args -p use_sim_time:=true``, resource
+limits, its own session, everything it started stopped with it) and simulation time is
+held until it is up on the graph, by the check grading uses
+(:mod:`autograder.sandbox.graph`). Its output streams to the terminal.
+
+Two things differ from grading, on purpose: isolation is always basic (strict isolation
+puts the whole graph in a network namespace of its own, where ``sim drive`` and
+``ros2 topic echo`` in another terminal could not reach it), and there is no time limit
+(the student stops a hand run with Ctrl-C or ``--duration``).
+
+``sim`` knows nothing of the autograder: :func:`add_node_options` gives the ``sim run``
+command its ``--node`` and ``--exercise`` options from here, and hands the node to the
+world as a :class:`sim.cli.Companion`.
+
+Exit codes as for every command (:mod:`autograder.commands.exits`), and 1 when the
+program did not get its node up.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import inspect
+import shutil
+import tempfile
+from collections.abc import Callable
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import click
+from click.core import ParameterSource
+
+from autograder.commands.exits import GraderFault, UsageProblem
+from autograder.core.errors import ContentError
+from autograder.core.output import describe_exit
+from autograder.i18n import _
+from sim.cli import COMPANION
+
+if TYPE_CHECKING:
+    from autograder.core.exercise import Exercise, Limits
+    from autograder.sandbox.process import StudentProcess
+    from sim.bridge import SimBridge
+
+# A hand run ends when the student says so: no wall or CPU time limit of the grading's.
+HAND_RUN_SECONDS = 24 * 3600
+# Wall seconds a plain node file (no exercise) has to get its node up.
+STARTUP_TIMEOUT = 20.0
+
+
+class NodeFailed(click.ClickException):
+    """The program did not get its node up: what the student's program did, not ours."""
+
+    exit_code = 1
+
+
+@dataclasses.dataclass
+class NodeRun:
+    """A student's node run with the world (a :class:`sim.cli.Companion`)."""
+
+    script: Path
+    exercise: Exercise | None = None
+    echo: Callable[[bytes], None] | None = None
+    process: StudentProcess | None = None
+    _folder: Path | None = None
+    _bridge: SimBridge | None = None
+    _ended_at: float | None = None
+
+    @property
+    def node_name(self) -> str | None:
+        """The node to wait for: the exercise's, or any new node for a plain file."""
+        return self.exercise.node if self.exercise is not None else None
+
+    def bridge_options(self) -> dict[str, Any]:
+        return {"cpu_budget": self.exercise.cpu_budget} if self.exercise is not None else {}
+
+    def start(self, bridge: SimBridge) -> None:
+        from autograder.core.submission import stage
+        from autograder.sandbox.graph import node_endpoints, wait_until_up
+        from autograder.sandbox.process import LaunchFailed, student_process
+
+        self._bridge = bridge
+        self._folder = Path(tempfile.mkdtemp(prefix="autograder-hand-"))
+        name = self.exercise.file if self.exercise is not None else self.script.name
+        staged = stage(self.script, name, self._folder / "staged")
+        course = self.exercise.folder.parent.parent if self.exercise else self._folder
+        self.process = student_process(staged, ["-p", "use_sim_time:=true"], self._limits(),
+                                       domain=bridge.node.context.get_domain_id(),
+                                       strict=False, course=course)
+        self.process.echo = self.echo
+        stale = node_endpoints(bridge.node, self.node_name)
+        try:
+            self.process.start()
+        except LaunchFailed as exc:
+            raise GraderFault(_("The autograder could not start your program ({detail}); "
+                                "this is not your fault, tell your instructor.").format(
+                detail=exc)) from None
+        bridge.watch_pid(self.process.pid)
+        timeout = self.exercise.startup_timeout if self.exercise else STARTUP_TIMEOUT
+        found = wait_until_up(bridge, bridge.node, self.node_name, stale,
+                              self.process.running, timeout)
+        if found:
+            click.echo(_("Node {names} is up; simulation time starts now.").format(
+                names=", ".join(sorted(set(found.values())))))
+            return
+        raise self._not_up(timeout)
+
+    def _limits(self) -> Limits:
+        from autograder.core.exercise import Limits
+
+        limits = self.exercise.limits if self.exercise is not None else Limits()
+        return dataclasses.replace(limits, wall_seconds=HAND_RUN_SECONDS,
+                                   cpu_seconds=HAND_RUN_SECONDS)
+
+    def _not_up(self, timeout: float) -> NodeFailed:
+        assert self.process is not None
+        if not self.process.running():
+            code = self.process.returncode
+            return NodeFailed(_("Your program {how} during start-up, before its node was up; "
+                                "its output is above.").format(
+                how=describe_exit(code if code is not None else 0)))
+        if self.exercise is None:
+            return NodeFailed(_("No node appeared on the ROS graph within {seconds:.0f} s."
+                                ).format(seconds=timeout))
+        return NodeFailed("\n".join((
+            _("No node named '{node}' appeared on the ROS graph within {seconds:.0f} s."
+              ).format(node=self.exercise.node, seconds=timeout),
+            _("Create the node with `super().__init__('{node}')` and spin it.").format(
+                node=self.exercise.node))))
+
+    def running(self) -> bool:
+        if self.process is not None and self.process.running():
+            return True
+        if self._ended_at is None and self._bridge is not None:
+            self._ended_at = self._bridge.now
+        return False
+
+    def stop(self) -> list[str]:
+        notes: list[str] = []
+        if self.process is not None:
+            ended_by_itself = not self.running()
+            status = self.process.stop()
+            if self._bridge is not None and self.process.popen is not None:
+                self._bridge.unwatch_pid(self.process.pid)
+            if ended_by_itself and status is not None and self._ended_at is not None:
+                notes.append(_("Your program {how} at {t:.2f} s of simulation time.").format(
+                    how=describe_exit(status), t=self._ended_at))
+        if self._folder is not None:
+            shutil.rmtree(self._folder, ignore_errors=True)
+        return notes
+
+
+def _check_syntax(script: Path) -> None:
+    """A syntax error is said at once, as grading says it, instead of after a start-up."""
+    try:
+        compile(script.read_text(encoding="utf-8", errors="replace"), script.name, "exec")
+    except SyntaxError as exc:
+        raise NodeFailed(_("{file}, line {line}: {error}").format(
+            file=script.name, line=exc.lineno, error=exc.msg)) from None
+
+
+def node_exercise(script: Path, given: str | None) -> Exercise | None:
+    """The exercise ``script`` is the node of: ``given`` (an id or folder), else the one
+    exercise whose ``file`` has the script's name, else None (a plain node)."""
+    from autograder.core.exercise import find_exercise, list_exercises
+
+    try:
+        if given is not None:
+            return find_exercise(given)
+        matches = [e for e in list_exercises() if e.file == script.name]
+    except ContentError as exc:
+        raise UsageProblem(str(exc)) from None
+    return matches[0] if len(matches) == 1 else None
+
+
+def exercise_world(exercise: Exercise) -> str:
+    """The exercise's world as ``sim run --world`` takes it (a file in its folder by path)."""
+    local = exercise.folder / exercise.world
+    return str(local) if local.suffix in (".yaml", ".yml") and local.exists() else exercise.world
+
+
+def _stdout_writer() -> Callable[[bytes], None]:
+    stream = click.get_binary_stream("stdout")
+
+    def write(chunk: bytes) -> None:
+        stream.write(chunk)
+        stream.flush()
+
+    return write
+
+
+def add_node_options(run: click.Command) -> None:
+    """Give ``sim run`` (``run``) the options ``--node FILE`` and ``--exercise ID``."""
+    if any(param.name == "node_file" for param in run.params):
+        return  # already given
+    run.params += [
+        click.Option(["--node", "node_file"], default=None,
+                     type=click.Path(exists=True, dir_okay=False, path_type=Path),
+                     help="Start this node file with the world, as grading starts it; "
+                          "simulation time starts once its node is up."),
+        click.Option(["--exercise"], default=None,
+                     help="The exercise the node file is for (default: the one whose file "
+                          "has its name); picks the exercise's world and pacing."),
+    ]
+    run.help = inspect.cleandoc(run.help or "") + (
+        "\n\nWith --node FILE the world starts your node itself, the way grading does "
+        "(sandboxed, with use_sim_time), and holds simulation time until the node is up, so "
+        "two runs of one node give the same trajectory. Drive it from another terminal "
+        "with 'autograder sim drive'.")
+    original = run.callback
+    assert original is not None
+
+    @functools.wraps(original)
+    def callback(node_file: Path | None, exercise: str | None, **kwargs: Any) -> Any:
+        ctx = click.get_current_context()
+        if node_file is None:
+            if exercise is not None:
+                raise click.UsageError(_("--exercise goes with --node FILE."))
+            return original(**kwargs)
+        _check_syntax(node_file)  # before the world: nothing to watch
+        found = node_exercise(node_file, exercise)
+        if found is not None:
+            click.echo(_("Running {file} as the node '{node}' of exercise {exercise}.").format(
+                file=node_file, node=found.node, exercise=found.id))
+            if ctx.get_parameter_source("world_name") is ParameterSource.DEFAULT:
+                kwargs["world_name"] = exercise_world(found)
+            if ctx.get_parameter_source("clock_hz") is ParameterSource.DEFAULT:
+                kwargs["clock_hz"] = found.clock_hz
+        ctx.meta[COMPANION] = NodeRun(node_file, found, echo=_stdout_writer())
+        return original(**kwargs)
+
+    run.callback = callback
