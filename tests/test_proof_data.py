@@ -79,6 +79,14 @@ def expectation(tmp_path: Path, text: str) -> Path:
      "may_also_lose lists a mutant's"),
     ("kind: mutant\nwhy: x\nloses: [test_node_starts]\nmay_also_lose: [test_node_starts]\n",
      "may_also_lose lists a mutant's"),
+    ("kind: mutant\nwhy: x\nloses: [test_node_starts]\nsays: {test_clamps_linear: [a]}\n",
+     "says maps tests in loses"),
+    ("kind: mutant\nwhy: x\nloses: [test_node_starts]\nsays: {test_node_starts: []}\n",
+     "says maps tests in loses"),
+    ("kind: mutant\nwhy: x\nloses: [test_node_starts]\nsays: {test_node_starts: a}\n",
+     "says maps tests in loses"),
+    ("kind: mutant\nwhy: x\nloses: [test_node_starts]\nsays: [test_node_starts]\n",
+     "says maps tests in loses"),
 ])
 def test_a_malformed_expectation_is_refused(tmp_path: Path, text: str, problem: str) -> None:
     """A typo must not quietly weaken a proof."""
@@ -143,3 +151,13 @@ def test_no_newline_at_end_of_file() -> None:
 def test_a_malformed_patch_is_refused(patch: str, problem: str) -> None:
     with pytest.raises(PatchError, match=problem):
         apply_patch("a\n", patch)
+
+
+def test_says_is_read_in_order_of_tests(tmp_path: Path) -> None:
+    """What a lost test's feedback must name comes through as written, per test."""
+    folder = expectation(tmp_path, "kind: mutant\nwhy: x\nloses: [test_node_starts, "
+                                   "test_clamps_linear]\nsays:\n  test_node_starts: [a, b]\n"
+                                   "  test_clamps_linear: [c]\n")
+    variant = load_variant(folder, find_exercise("parameter_validation"))
+    assert variant.says == (("test_clamps_linear", ("c",)), ("test_node_starts", ("a", "b")))
+
