@@ -161,3 +161,10 @@ def test_says_is_read_in_order_of_tests(tmp_path: Path) -> None:
     variant = load_variant(folder, find_exercise("parameter_validation"))
     assert variant.says == (("test_clamps_linear", ("c",)), ("test_node_starts", ("a", "b")))
 
+
+
+@pytest.mark.parametrize("exercise", EXERCISES)
+def test_feedback_expectations_are_aimed_at_lost_tests(exercise: str) -> None:
+    """Every exercise states, for some known-bad variant, what its feedback must name."""
+    variants = load_variants(find_exercise(exercise)).values()
+    assert any(v.says for v in variants if v.kind != "correct")
