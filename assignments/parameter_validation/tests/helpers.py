@@ -71,7 +71,7 @@ def example_reason(name: str, value: object) -> str:
         return f"{name} must be within [{low}, {high}], got {value}"
     if name == "robot_name" and value == "":
         return "robot_name must not be empty"
-    return f"{name} must be a {type(DEFAULTS[name]).__name__}"
+    return f"{name} must be a {'string' if name == 'robot_name' else 'double'}"
 
 
 def accepted_hint(name: str, value: object) -> str:
