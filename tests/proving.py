@@ -8,6 +8,8 @@ as an exact set::
     kind: mutant            # correct | mutant (a known flaw) | broken (does not run right)
     why: relays linear.x unclamped
     loses: [test_clamps_linear, test_speed_stays_under_limit]
+    says:                   # optional: what a lost test's message or hint must name
+      test_clamps_linear: ["linear.x=3.0 was passed on unclamped"]
 
 and the program is either the exercise's file itself (an alternative correct design,
 written its own way) or ``<file>.patch``: a unified diff against the exercise's reference
@@ -20,6 +22,7 @@ STANDARD_CHECKS below to it, grades the PROOF once per module (the ``graded`` fi
 parametrizes ``correct`` and ``known_bad`` from the folders.
 
     python tests/proving.py losses EXERCISE    # grade everything, print what each lost
+                                               # and what each lost test said
     python tests/proving.py patch FOLDER       # turn a full copy into FILE.patch
 """
 
@@ -163,6 +166,9 @@ class Variant:
     # next to other gradings (a wall-clock timer against a lagging world): named, with
     # the reason in expect.yaml, never a blanket allowance.
     may_also_lose: frozenset[str] = frozenset()
+    # For a lost test, words its feedback (message or hint, in English) must contain: the
+    # value or case that failed and the fix for it, not a generic reminder of the API.
+    says: tuple[tuple[str, tuple[str, ...]], ...] = ()
 
     def program(self, exercise: Exercise) -> str:
         """The submitted file's text: the folder's own copy, or the patched solution."""
@@ -199,8 +205,8 @@ def load_variant(folder: Path, exercise: Exercise) -> Variant:
         raise wrong("missing: every submission folder says what it must lose")
     data = yaml.safe_load(path.read_text(encoding="utf-8"))
     if not isinstance(data, dict) or not {"kind", "why", "loses"} <= set(data) \
-            or set(data) - {"kind", "why", "loses", "may_also_lose"}:
-        raise wrong("needs the keys kind, why and loses (and may have may_also_lose)")
+            or set(data) - {"kind", "why", "loses", "may_also_lose", "says"}:
+        raise wrong("needs the keys kind, why and loses (and may have may_also_lose, says)")
     kind, why, loses = data["kind"], data["why"], data["loses"]
     may = data.get("may_also_lose", [])
     if not isinstance(may, list) or not all(isinstance(t, str) for t in may) \
@@ -219,11 +225,18 @@ def load_variant(folder: Path, exercise: Exercise) -> Variant:
     unknown = (set(loses) | set(may)) - exercise_tests(exercise)
     if unknown:
         raise wrong(f"no such tests in {exercise.id}: {', '.join(sorted(unknown))}")
+    says = data.get("says", {})
+    if not isinstance(says, dict) or not set(says) <= set(loses) or not all(
+            isinstance(words, list) and words
+            and all(isinstance(w, str) and w.strip() for w in words)
+            for words in says.values()):
+        raise wrong("says maps tests in loses to lists of words their feedback names")
     files = [p for p in (folder / exercise.file, folder / f"{exercise.file}.patch")
              if p.exists()]
     if len(files) != 1:
         raise wrong(f"needs {exercise.file} or {exercise.file}.patch, and only one")
-    return Variant(folder.name, folder, kind, why.strip(), frozenset(loses), frozenset(may))
+    return Variant(folder.name, folder, kind, why.strip(), frozenset(loses), frozenset(may),
+                   tuple((test, tuple(words)) for test, words in sorted(says.items())))
 
 
 def load_variants(exercise: Exercise) -> dict[str, Variant]:
@@ -316,19 +329,40 @@ def test_known_bad_variant_loses_exactly_the_tests_aimed_at_it(
         "lost, though not expected": sorted(lost - variant.loses - variant.may_also_lose)}
 
 
+def test_known_bad_variant_is_told_what_was_observed(
+        graded: dict[str, RunResult], proof: Proof, known_bad: str) -> None:
+    """A lost test names the value or case that failed and its fix (``says``)."""
+    by_name = {t.name: t for t in graded[known_bad].tests}
+    missing = {test: [w for w in words
+                      if w not in f"{by_name[test].message}\n{by_name[test].hint}"]
+               for test, words in proof.variants[known_bad].says}
+    assert not any(missing.values()), {
+        test: {"missing": words, "message": by_name[test].message, "hint": by_name[test].hint}
+        for test, words in missing.items() if words}
+
+
+def test_each_hint_is_given_once(graded: dict[str, RunResult]) -> None:
+    """A hint is not repeated in its own test's message (one place for the fix)."""
+    repeated = {f"{name}: {t.name}": t.hint for name, result in graded.items()
+                for t in result.tests if t.hint and t.hint.strip() in t.message}
+    assert not repeated
+
+
 # What every exercise's proof checks: tests/conftest.py adds these to each module that
 # declares PROOF, parametrized from its submission folders (``correct``, ``known_bad``).
 STANDARD_CHECKS = (test_reference_scores_full_marks_every_time,
                    test_starter_is_below_the_pass_mark,
                    test_other_correct_designs_score_full_marks,
-                   test_known_bad_variant_loses_exactly_the_tests_aimed_at_it)
+                   test_known_bad_variant_loses_exactly_the_tests_aimed_at_it,
+                   test_known_bad_variant_is_told_what_was_observed,
+                   test_each_hint_is_given_once)
 
 
 # -- tools -----------------------------------------------------------------------------------
 
 def _losses(exercise_id: str) -> None:
-    """Grade every submission of an exercise and print what each lost, beside what its
-    ``expect.yaml`` says: where an expectation comes from."""
+    """Grade every submission of an exercise and print what each lost and what each lost
+    test said, beside what its ``expect.yaml`` says: where an expectation comes from."""
     proof = Proof(exercise_id)
     with tempfile.TemporaryDirectory() as tmp:
         results = proof.grade_all(Path(tmp))
@@ -340,6 +374,10 @@ def _losses(exercise_id: str) -> None:
         mark = "" if fits else "  # differs"
         print(f"{name}: score {result.score}/{result.max_score}, "
               f"grader_error {result.grader_error}{mark}\n  loses: [{', '.join(lost)}]")
+        for test in result.tests:  # what each lost test said: where `says` comes from
+            if test.name in lost:
+                print(f"    {test.name}: {test.message.splitlines()[0] if test.message else ''}"
+                      f"\n      hint: {test.hint}")
 
 
 def _patch(folder: Path) -> None:

@@ -9,12 +9,15 @@ expectation shows here in a second.
 from __future__ import annotations
 
 from pathlib import Path
+from types import SimpleNamespace
 
+import proving
 import pytest
 from proving import (
     NOT_PROOFS,
     SUBMISSIONS,
     PatchError,
+    Proof,
     apply_patch,
     exercise_tests,
     load_variant,
@@ -79,6 +82,14 @@ def expectation(tmp_path: Path, text: str) -> Path:
      "may_also_lose lists a mutant's"),
     ("kind: mutant\nwhy: x\nloses: [test_node_starts]\nmay_also_lose: [test_node_starts]\n",
      "may_also_lose lists a mutant's"),
+    ("kind: mutant\nwhy: x\nloses: [test_node_starts]\nsays: {test_clamps_linear: [a]}\n",
+     "says maps tests in loses"),
+    ("kind: mutant\nwhy: x\nloses: [test_node_starts]\nsays: {test_node_starts: []}\n",
+     "says maps tests in loses"),
+    ("kind: mutant\nwhy: x\nloses: [test_node_starts]\nsays: {test_node_starts: a}\n",
+     "says maps tests in loses"),
+    ("kind: mutant\nwhy: x\nloses: [test_node_starts]\nsays: [test_node_starts]\n",
+     "says maps tests in loses"),
 ])
 def test_a_malformed_expectation_is_refused(tmp_path: Path, text: str, problem: str) -> None:
     """A typo must not quietly weaken a proof."""
@@ -143,3 +154,48 @@ def test_no_newline_at_end_of_file() -> None:
 def test_a_malformed_patch_is_refused(patch: str, problem: str) -> None:
     with pytest.raises(PatchError, match=problem):
         apply_patch("a\n", patch)
+
+
+def test_says_is_read_in_order_of_tests(tmp_path: Path) -> None:
+    """What a lost test's feedback must name comes through as written, per test."""
+    folder = expectation(tmp_path, "kind: mutant\nwhy: x\nloses: [test_node_starts, "
+                                   "test_clamps_linear]\nsays:\n  test_node_starts: [a, b]\n"
+                                   "  test_clamps_linear: [c]\n")
+    variant = load_variant(folder, find_exercise("parameter_validation"))
+    assert variant.says == (("test_clamps_linear", ("c",)), ("test_node_starts", ("a", "b")))
+
+
+
+@pytest.mark.parametrize("exercise", EXERCISES)
+def test_feedback_expectations_are_aimed_at_lost_tests(exercise: str) -> None:
+    """Every exercise states, for some known-bad variant, what its feedback must name."""
+    variants = load_variants(find_exercise(exercise)).values()
+    assert any(v.says for v in variants if v.kind != "correct")
+
+
+def _graded(message: str, hint: str) -> dict:
+    """upper_bound_only's results as the proof checks see them: its two lost tests, the
+    first saying ``message`` and ``hint``."""
+    tests = [SimpleNamespace(name="test_refuses_out_of_range", message=message, hint=hint),
+             SimpleNamespace(name="test_invalid_override_exits",
+                             message="Started with -p max_angular_speed:=-1.0, ...",
+                             hint="... check the lower bound there too ...")]
+    return {"upper_bound_only": SimpleNamespace(tests=tests)}
+
+
+def test_the_says_check_fails_when_feedback_does_not_name_the_case() -> None:
+    proof = Proof("parameter_validation")
+    told = _graded("Setting max_linear_speed to -0.1 was accepted; it must be refused.",
+                   "Check the lower bound too: ...")
+    proving.test_known_bad_variant_is_told_what_was_observed(told, proof, "upper_bound_only")
+    generic = _graded("Setting max_linear_speed to -0.1 was accepted; it must be refused.",
+                      "Return `SetParametersResult(successful=False, reason=...)`.")
+    with pytest.raises(AssertionError, match="lower bound"):
+        proving.test_known_bad_variant_is_told_what_was_observed(generic, proof,
+                                                                 "upper_bound_only")
+
+
+def test_the_once_check_fails_on_a_hint_repeated_in_its_message() -> None:
+    proving.test_each_hint_is_given_once(_graded("It failed.", "Fix it."))
+    with pytest.raises(AssertionError):
+        proving.test_each_hint_is_given_once(_graded("It failed. Fix it.", "Fix it."))

@@ -143,8 +143,13 @@ def judge_reached(mission: Mission, credit: Any, world_name: str) -> None:
             world=world_name, seconds=mission.end - mission.t0, limit=mission.limit,
             stalled=STALLED, reached=REACHED, left=left,
             speed=abs(last.v) if last else 0.0, share=progress)
-        hint = _("Stop (a zero Twist) once the odometry puts you within 0.3 m of "
-                 "(goal_x, goal_y); is the goal read from the parameters?")
+        if last is not None and abs(last.v) < STILL and abs(last.w) < 5 * STILL:
+            hint = _("It stood still outside {reached} m of the goal, which is not arriving: "
+                     "drive on until the odometry puts you within {reached} m of "
+                     "(goal_x, goal_y), then stop.").format(reached=REACHED)
+        else:
+            hint = _("Stop (a zero Twist) once the odometry puts you within 0.3 m of "
+                     "(goal_x, goal_y); is the goal read from the parameters?")
     credit.award(min(progress, 0.99), message, hint)
 
 

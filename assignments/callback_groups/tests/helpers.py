@@ -18,7 +18,7 @@ import pytest
 from std_srvs.srv import Trigger
 
 from autograder.core.errors import StudentFailure
-from autograder.i18n import _
+from autograder.i18n import _, ngettext
 
 SERVICE = "check_path"
 SECTOR = math.radians(30.0)
@@ -40,16 +40,24 @@ class Answer:
         return None if self.answered is None else self.answered - self.sent
 
 
-def nearest_ahead(scan: Any) -> float | None:
-    """The smallest valid reading within +-30 degrees of straight ahead (None: none)."""
-    best = None
+def ahead(scan: Any) -> list[float]:
+    """Every reading within +-30 degrees of straight ahead, valid or not."""
+    found = []
     for i, r in enumerate(scan.ranges):
         angle = scan.angle_min + i * scan.angle_increment
         angle = math.atan2(math.sin(angle), math.cos(angle))
-        if math.isfinite(r) and scan.range_min <= r <= scan.range_max and \
-                abs(angle) <= SECTOR + 1e-9 and (best is None or r < best):
-            best = r
-    return best
+        if abs(angle) <= SECTOR + 1e-9:
+            found.append(r)
+    return found
+
+
+def valid(scan: Any, r: float) -> bool:
+    return math.isfinite(r) and scan.range_min <= r <= scan.range_max
+
+
+def nearest_ahead(scan: Any) -> float | None:
+    """The smallest valid reading within +-30 degrees of straight ahead (None: none)."""
+    return min((r for r in ahead(scan) if valid(scan, r)), default=None)
 
 
 def numbers(text: str) -> list[float]:
@@ -166,10 +174,7 @@ def judge(answer: Answer, scan: Any, where: str) -> None:
               "success must be {want}.").format(
                 where=where, got=response.success, message=response.message,
                 nearest=expected if expected is not None else float("inf"), want=clear),
-            _("Use only readings that are finite and within [range_min, range_max], at "
-              "angles within +-30 degrees of straight ahead (wrap angle_min + i * "
-              "angle_increment into [-pi, pi]); success means all of them are at least "
-              "0.5 m."))
+            _success_hint(scan, expected, response.success))
     if expected is not None and not any(abs(n - expected) <= DISTANCE_TOLERANCE
                                         for n in numbers(response.message)):
         raise StudentFailure(
@@ -178,6 +183,28 @@ def judge(answer: Answer, scan: Any, where: str) -> None:
                 where=where, message=response.message, nearest=expected),
             _("Put the distance in the message, e.g. f'nearest obstacle ahead: "
               "{{nearest:.2f}} m'.").format())
+
+
+def _success_hint(scan: Any, nearest: float | None, said: bool) -> str:
+    """Why the success flag came out wrong, by what the scan held."""
+    invalid = [r for r in ahead(scan) if not valid(scan, r)] if scan is not None else []
+    if not said and invalid:
+        return ngettext(
+            "{count} reading ahead was invalid (NaN, +-inf, or outside [{low}, {high}] m): "
+            "it is no obstacle. Skip a reading unless it is finite and within "
+            "[range_min, range_max].",
+            "{count} readings ahead were invalid (NaN, +-inf, or outside [{low}, {high}] m): "
+            "they are no obstacle. Skip a reading unless it is finite and within "
+            "[range_min, range_max].", len(invalid)).format(
+            count=len(invalid), low=scan.range_min, high=scan.range_max)
+    if said and nearest is not None:
+        return _("{nearest:.2f} m ahead is under 0.5 m, yet the path was called clear: it is "
+                 "clear only when every valid reading within +-30 degrees is at least 0.5 m. "
+                 "Check your threshold.").format(nearest=nearest)
+    return _("Use only readings that are finite and within [range_min, range_max], at "
+             "angles within +-30 degrees of straight ahead (wrap angle_min + i * "
+             "angle_increment into [-pi, pi]); success means all of them are at least "
+             "0.5 m.")
 
 
 def rate_reports(rates: Any, start: float, end: float) -> list[float]:

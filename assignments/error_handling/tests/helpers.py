@@ -98,6 +98,29 @@ def describe(t: Twist) -> str:
     return f"linear.x={t.linear.x:.3g}, angular.z={t.angular.z:.3g}"
 
 
+# The last line of a Python traceback: "ValueError: cannot convert float NaN to integer".
+RAISED = re.compile(r"^(?:[A-Za-z_][\w.]*\.)?([A-Z]\w*(?:Error|Exception))\b(?::.*)?$",
+                    re.MULTILINE)
+
+
+def raised(output: str) -> str | None:
+    """The name of the exception the last traceback in ``output`` ended with, if any."""
+    if "Traceback" not in output:
+        return None
+    found = RAISED.findall(output[output.rindex("Traceback"):])
+    return found[-1] if found else None
+
+
+def exception_hint(output: str) -> str:
+    """Catch exceptions in callbacks; name the one the node raised, when it shows."""
+    error = raised(output)
+    if error:
+        return _("It raised {error}: catch exceptions inside your callbacks, log them with "
+                 "get_logger().error(...), publish a stop and carry on.").format(error=error)
+    return _("Catch exceptions inside your callbacks: log them with get_logger().error(...), "
+             "publish a stop and carry on.")
+
+
 def alive(probe: Any, inbox: Any, node: Any, when: str) -> None:
     """Fail with the node's last words if its process ended or it stopped publishing."""
     probe.settle(inbox)
@@ -105,16 +128,14 @@ def alive(probe: Any, inbox: Any, node: Any, when: str) -> None:
         raise StudentFailure(
             _("The node's process ended {when} (exit status {code}). Its last lines:\n{tail}")
             .format(when=when, code=node.returncode, tail=node.output_tail(12)),
-            _("Catch exceptions inside your callbacks: log them with get_logger().error(...), "
-              "publish a stop and carry on."))
+            exception_hint(node.output()))
     stamps = inbox.times
     if not stamps or stamps[-1] < probe.now - SILENT:
         raise StudentFailure(
             _("The node stopped publishing on cmd_vel {when}, though its process still runs "
               "(did an exception end the thread that spins?). Its last lines:\n{tail}")
             .format(when=when, tail=node.output_tail(12)),
-            _("Catch exceptions inside your callbacks: log them with get_logger().error(...), "
-              "publish a stop and carry on."))
+            exception_hint(node.output()))
 
 
 def wait_command(probe: Any, inbox: Any, since: float, wanted: Callable[[Twist], bool],

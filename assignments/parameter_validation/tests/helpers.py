@@ -9,6 +9,9 @@ from autograder.i18n import _
 
 # After an answer arrives, this much simulation time is watched for a second one.
 SETTLE = 0.3
+# What the README accepts for each speed limit, and the starting values.
+RANGES = {"max_linear_speed": (0.0, 1.5), "max_angular_speed": (0.0, 2.5)}
+DEFAULTS = {"max_linear_speed": 0.5, "max_angular_speed": 1.0, "robot_name": "tb3"}
 
 
 def twist(linear_x: float = 0.0, angular_z: float = 0.0, **others: float) -> Twist:
@@ -53,3 +56,56 @@ def answer(probe, inbox, wish: Twist) -> Twist:
 
 def close(a: float, b: float) -> bool:
     return abs(a - b) <= 1e-6
+
+
+# -- hints: the fix for the case that was observed ---------------------------------------
+
+def clamp(value: float, limit: float) -> float:
+    return max(-limit, min(limit, value))
+
+
+def example_reason(name: str, value: object) -> str:
+    """A reason the README would accept for refusing ``value`` (the student's own text)."""
+    if name in RANGES and isinstance(value, float):
+        low, high = RANGES[name]
+        return f"{name} must be within [{low}, {high}], got {value}"
+    if name == "robot_name" and value == "":
+        return "robot_name must not be empty"
+    return f"{name} must be a {'string' if name == 'robot_name' else 'double'}"
+
+
+def accepted_hint(name: str, value: object) -> str:
+    """Why a bad value got through, by what was wrong with it, and the fix for that."""
+    default = DEFAULTS[name]
+    if type(value) is not type(default):
+        return _("rclpy refuses a value of another type by itself unless the parameter was "
+                 "declared to take any type. Declare it with a default of its own type, "
+                 "`declare_parameter('{name}', {default!r})`, without "
+                 "`dynamic_typing=True`.").format(name=name, default=default)
+    if name in RANGES:
+        low, high = RANGES[name]
+        if value < low:
+            return _("Check the lower bound too: in your on-set parameters callback, refuse "
+                     "{name} below {low} with `SetParametersResult(successful=False, "
+                     "reason=...)`. With a negative limit, `max(-limit, min(limit, v))` "
+                     "gives {speed} whatever the agent asks: the robot moves on its "
+                     "own.").format(name=name, low=low, speed=-value)
+        return _("Check the upper bound: in your on-set parameters callback, refuse {name} "
+                 "above {high} with `SetParametersResult(successful=False, "
+                 "reason=...)`.").format(name=name, high=high)
+    return _("Check for the empty string in your on-set parameters callback (`if not "
+             "param.value`) and refuse it with `SetParametersResult(successful=False, "
+             "reason=...)`.")
+
+
+def clamp_hint(field: str, name: str, limit: float, asked: float, got: float) -> str:
+    """The fix for a clamp that gave ``got`` for ``asked`` under ``limit``."""
+    if close(got, asked):
+        return _("{field}={asked} was passed on unclamped: clamp it with "
+                 "`max(-limit, min(limit, value))`, where limit is {name}.").format(
+            field=field, asked=asked, name=name)
+    if close(got, -clamp(asked, limit)):
+        return _("The sign was lost: clamp with `max(-limit, min(limit, value))`, which keeps "
+                 "it, not with `abs()`.")
+    return _("Clamp {field} with `max(-limit, min(limit, value))`, where limit is {name} "
+             "({limit}).").format(field=field, name=name, limit=limit)

@@ -147,6 +147,45 @@ def freeze_hint() -> str:
              "group of its own.")
 
 
+def planner_run_during(run: Run, a: float, b: float) -> tuple[float, float] | None:
+    """The planner run (its start and the plan that ended it) overlapping [a, b], if any:
+    a gap there was the planner's doing."""
+    for done in (t for t, _m in run.plans):
+        began = done - PLAN_SECONDS
+        if a < done + 0.1 and b > began:
+            return began, done
+    return None
+
+
+def blocked_hint(run: Run, gap: float, where: float, status: bool = False) -> str | None:
+    """The fix when the gap at ``where`` in cmd_vel (or status) fell on a planner run
+    (None: it did not)."""
+    during = planner_run_during(run, where, where + gap)
+    if during is None:
+        return None
+    if status:
+        text = _("The gap fell on a planner run (t={a:.2f} to {b:.2f} s): while plan_route() "
+                 "blocked, the status timer could not run. Give the planner timer a callback "
+                 "group of its own and spin a MultiThreadedExecutor.")
+    else:
+        text = _("The gap fell on a planner run (t={a:.2f} to {b:.2f} s): while plan_route() "
+                 "blocked, the control timer could not run. Give the planner timer a "
+                 "callback group of its own and spin a MultiThreadedExecutor.")
+    return text.format(a=during[0], b=during[1])
+
+
+def too_fast(count: int, seconds: float, hz: float) -> bool:
+    """More messages than the rate allows, as a timer on the wall clock gives when the
+    world runs slower than real time."""
+    return count > seconds * hz * (1 + RATE_TOLERANCE) + 1.0
+
+
+def wall_clock_hint() -> str:
+    return _("Time everything with the node's timers (self.create_timer) and clock "
+             "(self.get_clock()), never time.sleep or time.time: with use_sim_time they "
+             "follow /clock, whatever its pace.")
+
+
 def gaps(times: list[float], start: float, end: float) -> list[tuple[float, float]]:
     """(gap, where) for each interval between messages, the window's edges included."""
     points = [start, *times, end]

@@ -18,7 +18,7 @@ from helpers import (
 )
 
 from autograder.core.errors import StudentFailure
-from autograder.i18n import _
+from autograder.i18n import _, ngettext
 from sim.worldfile import Box, Fault
 
 BOX_AHEAD = Box(center=(3.45, 3.0), size=(0.1, 0.6))
@@ -57,12 +57,12 @@ def test_concurrent_requests(student, probe, scans, rates, alive):
         if late:
             got = sum(1 for a in answers if a.answered is not None)
             raise StudentFailure(
-                _("Of {n} requests sent together, {got} were answered and {late} took more "
-                  "than 1.0 s of simulation time (or never came).").format(
-                    n=CONCURRENT, got=got, late=len(late)),
-                _("While one request waits for its scan, the others must not wait for it: a "
-                  "ReentrantCallbackGroup for the service (and enough executor threads), or "
-                  "requests served one after another, each within 0.1 s."))
+                ngettext("{late} of {n} requests sent together took more than 1.0 s of "
+                         "simulation time or was never answered (answered: {got} of {n}).",
+                         "{late} of {n} requests sent together took more than 1.0 s of "
+                         "simulation time or were never answered (answered: {got} of {n}).",
+                         len(late)).format(n=CONCURRENT, got=got, late=len(late)),
+                _concurrency_hint(answers))
         for answer in answers:
             judge(answer, scan_after(probe, scans, answer.sent),
                   _("Among five requests sent together"))
@@ -77,6 +77,19 @@ def test_concurrent_requests(student, probe, scans, rates, alive):
                   "give the service a callback group of its own."))
     finally:
         requests.close()
+
+
+def _concurrency_hint(answers: list) -> str:
+    """Answers that came one after another, each a wait later: they queued."""
+    latencies = sorted(a.latency for a in answers if a.latency is not None)
+    if len(latencies) == len(answers) and latencies[-1] - latencies[0] > ANSWER_WITHIN / 2:
+        return _("The answers came {latencies} s after the requests: one after another, each "
+                 "waiting for the one before. Give the service a ReentrantCallbackGroup of "
+                 "its own (and enough executor threads), or serve each request within "
+                 "0.1 s.").format(latencies=", ".join(f"{t:.2f}" for t in latencies))
+    return _("While one request waits for its scan, the others must not wait for it: a "
+             "ReentrantCallbackGroup for the service (and enough executor threads), or "
+             "requests served one after another, each within 0.1 s.")
 
 
 @pytest.mark.points(1)
@@ -97,6 +110,10 @@ def test_no_fresh_scan(student, probe, world, alive):
               "path cannot be confirmed clear, so success must be false.").format(
                 got=getattr(response, "success", None),
                 message=getattr(response, "message", "")),
+            _("It answered {latency:.2f} s after the request, so from a scan older than the "
+              "request: wait up to 1.0 s of ROS time for a scan that arrives after it, and "
+              "answer success=False when none comes.").format(latency=answer.latency)
+            if response is not None and answer.latency < 0.5 else
             _("Answer only from a scan that arrives after the request; when none comes "
               "within 1.0 s, say so with success=False."))
     # 1.0 s of ROS time is asked for; a wall-clock wait of 1.0 s is let pass (sim time

@@ -17,7 +17,7 @@ from helpers import (
 )
 
 from autograder.core.errors import GraderError, StudentFailure
-from autograder.i18n import _
+from autograder.i18n import _, ngettext
 from sim.worldfile import Box, Fault
 
 # A box whose near face is 0.40 m ahead of the robot: inside 0.5 m, outside 0.3 m.
@@ -35,6 +35,9 @@ def test_node_starts(student, probe, scans, rates):
     if not probe.wait_for(lambda: len(rates) > 0, 3.0):
         raise StudentFailure(
             _("Nothing came on scans_per_second within 3 s of simulation time."),
+            _("Nothing publishes on scans_per_second: create a publisher, "
+              "`self.create_publisher(Float32, 'scans_per_second', 10)`, and publish the "
+              "count from a 1 s timer.") if rates.publisher_count() == 0 else
             _("Publish a std_msgs/Float32 on scans_per_second from a 1 s timer, and spin "
               "the node: a MultiThreadedExecutor, not Jazzy's experimental EventsExecutor, "
               "which ignores callback groups and, measured here, never ran a callback."))
@@ -46,13 +49,18 @@ def test_scan_rate(student, probe, scans, rates, alive):
     require_alive(alive)
     start = probe.now
     probe.wait_for(lambda: sum(1 for t in rates.times if t > start) >= 4, 6.0)
-    values = [m.data for t, m in rates.items if t > start][1:]  # the first may be partial
+    came = [m.data for t, m in rates.items if t > start]
+    values = came[1:]  # the first may be partial
     if len(values) < 3:
         raise StudentFailure(
-            _("scans_per_second came {count} times in {seconds:.1f} s of simulation time; "
-              "expected once a second.").format(count=len(values) + 1,
-                                                seconds=probe.now - start),
-            _("Publish it from a timer with a period of 1.0 s."))
+            ngettext("scans_per_second came {count} time in {seconds:.1f} s of simulation "
+                     "time; expected once a second.",
+                     "scans_per_second came {count} times in {seconds:.1f} s of simulation "
+                     "time; expected once a second.", len(came)).format(
+                count=len(came), seconds=probe.now - start),
+            _("Publish it from a timer with a period of 1.0 s.") if came else
+            _("The node's callbacks run, yet nothing came on scans_per_second: call "
+              "publish() in the 1 s timer's callback."))
     wrong = [v for v in values if not RATE_LOW <= v <= RATE_HIGH]
     if wrong:
         raise StudentFailure(

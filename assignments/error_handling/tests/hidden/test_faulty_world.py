@@ -13,10 +13,10 @@ import time
 from typing import Any
 
 import pytest
-from helpers import LATE, describe, is_zero, warnings_between, window
+from helpers import LATE, describe, is_zero, raised, warnings_between, window
 
 from autograder.core.errors import StudentFailure
-from autograder.i18n import _
+from autograder.i18n import _, ngettext
 from autograder.plugin.collisions import with_front_beam_note
 from sim.worldfile import Fault
 
@@ -116,9 +116,13 @@ def _died(run: Run, student) -> None:
         message = _("The node stopped publishing on cmd_vel {seconds:.1f} s into the run, "
                     "though its process still ran (did an exception end the thread that "
                     "spins?), so the rest could not be judged. Its last lines:\n{tail}")
+    error = raised(run.output)
     raise StudentFailure(
         message.format(seconds=run.died_at - run.start, code=student.returncode,
                        tail=student.output_tail(12)),
+        _("It raised {error} on a faulty scan: catch exceptions in your callbacks and "
+          "ignore invalid readings; the public tests show which scans hurt.").format(
+            error=error) if error else
         _("Catch exceptions in your callbacks and ignore invalid readings; the public "
           "tests show which scans hurt."))
 
@@ -180,10 +184,14 @@ def test_stops_during_dropout(run, world, student):
                   "cycle once it is more than 0.5 s old (in ROS time)."))
         if len(sent) < cycles / 2:  # every cycle, less what a busy machine may cost
             raise StudentFailure(
-                _("While the lidar was silent ({seconds:.1f} s into the run) cmd_vel was "
-                  "published {count} times in {span:.1f} s; a stop is due on every 10 Hz "
-                  "cycle.").format(seconds=d.start - run.start, count=len(sent),
-                                   span=d.end - d.start - STOP_WITHIN),
+                ngettext("While the lidar was silent ({seconds:.1f} s into the run) cmd_vel "
+                         "was published {count} time in {span:.1f} s; a stop is due on every "
+                         "10 Hz cycle.",
+                         "While the lidar was silent ({seconds:.1f} s into the run) cmd_vel "
+                         "was published {count} times in {span:.1f} s; a stop is due on every "
+                         "10 Hz cycle.", len(sent)).format(
+                    seconds=d.start - run.start, count=len(sent),
+                    span=d.end - d.start - STOP_WITHIN),
                 _("Publish from the timer, not from the scan callback."))
 
 
@@ -217,7 +225,9 @@ def test_log_not_flooded(run, student):
                 _("Log it: self.get_logger().warn('no scan ...', throttle_duration_sec=1.0)."))
         if count > allowed:
             raise StudentFailure(
-                _("The lidar was silent for {span:.0f} s and the node logged {count} "
-                  "warnings; at most about one a second ({allowed}) is useful.").format(
-                    span=d.end - d.start, count=count, allowed=allowed),
+                ngettext("The lidar was silent for {span:.0f} s and the node logged {count} "
+                         "warning; at most about one a second ({allowed}) is useful.",
+                         "The lidar was silent for {span:.0f} s and the node logged {count} "
+                         "warnings; at most about one a second ({allowed}) is useful.",
+                         count).format(span=d.end - d.start, count=count, allowed=allowed),
                 _("Throttle the warning: get_logger().warn(..., throttle_duration_sec=1.0)."))

@@ -12,7 +12,7 @@ import signal
 
 import pytest
 from geometry_msgs.msg import Twist
-from helpers import describe, is_zero
+from helpers import describe, is_zero, raised
 
 from autograder.core.errors import StudentFailure
 from autograder.i18n import _
@@ -54,7 +54,7 @@ def _trial(probe, start_node, sig: signal.Signals, trial: int) -> None:
               "{code}{traceback}. Its last lines:\n{tail}").format(
                 signal=name, trial=trial, trials=TRIALS, code=code,
                 traceback=_(" and a traceback") if "Traceback" in output else "",
-                tail=node.output_tail(12)), HINT)
+                tail=node.output_tail(12)), _exit_hint(output))
 
     def stopped() -> bool:
         messages = commands.messages
@@ -70,7 +70,21 @@ def _trial(probe, start_node, sig: signal.Signals, trial: int) -> None:
             _("After {signal} (trial {trial} of {trials}) the last command on cmd_vel was "
               "{got}: the robot would drive on with nobody in charge. The last message must "
               "be a zero Twist.").format(signal=name, trial=trial, trials=TRIALS,
-                                         got=describe(last)), HINT)
+                                         got=describe(last)),
+            _("Publish Twist() as the very last thing, once the executor has stopped, and "
+              "wait_for_all_acked before destroying the node, so that the stop is delivered "
+              "before the process ends. {fix}").format(fix=HINT))
+
+
+def _exit_hint(output: str) -> str:
+    """Name what went wrong when the traceback shows rclpy's own signal handling."""
+    error = raised(output)
+    if error in ("RCLError", "ExternalShutdownException") or \
+            (error and "context is invalid" in output):
+        return _("The traceback ends in {error}: rclpy's own signal handler shut the context "
+                 "down before your code published its stop. {fix}").format(error=error,
+                                                                          fix=HINT)
+    return HINT
 
 
 @pytest.mark.points(2)

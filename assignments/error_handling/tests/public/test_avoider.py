@@ -29,7 +29,7 @@ from helpers import (
 from sensor_msgs.msg import LaserScan
 
 from autograder.core.errors import StudentFailure
-from autograder.i18n import _
+from autograder.i18n import _, ngettext
 from sim.worldfile import Fault
 
 pytestmark = pytest.mark.world("empty_room")
@@ -72,10 +72,15 @@ def test_publishes_at_10_hz(avoider, feeder, probe, commands):
     count = len(window(commands, start, start + 3.0))
     if not 24 <= count <= 36:  # 10 Hz, give or take cycles a busy machine may cost
         raise StudentFailure(
-            _("In 3 s of simulation time cmd_vel was published {count} times; a 10 Hz timer "
-              "gives 30.").format(count=count),
-            _("Publish exactly once per cycle of self.create_timer(0.1, ...), not from the "
-              "scan callback."))
+            ngettext("In 3 s of simulation time cmd_vel was published {count} time; a 10 Hz "
+                     "timer gives 30.",
+                     "In 3 s of simulation time cmd_vel was published {count} times; a 10 Hz "
+                     "timer gives 30.", count).format(count=count),
+            _("That is more than once a cycle: publish only from the timer of "
+              "self.create_timer(0.1, ...), not from the scan callback as well.") if count > 36
+            else _("That is less than once a cycle: publish on every cycle of "
+                   "self.create_timer(0.1, ...), a stop included, not only from the scan "
+                   "callback or when something changes."))
 
 
 @pytest.mark.points(1)
@@ -88,7 +93,9 @@ def test_drives_when_clear(avoider, feeder, probe, commands):
     if wrong:
         raise StudentFailure(
             _("With a clear way ahead cmd_vel said {got}; expected linear.x={v}, "
-              "angular.z=0 on every cycle.").format(got=describe(wrong[0]), v=FORWARD))
+              "angular.z=0 on every cycle.").format(got=describe(wrong[0]), v=FORWARD),
+            _("Nothing was nearer than 2 m: with no valid reading within ±30° of ahead at "
+              "0.6 m or nearer, publish linear.x=0.2, angular.z=0 on every cycle."))
 
 
 @pytest.mark.points(2)
@@ -104,6 +111,9 @@ def test_turns_toward_room(avoider, feeder, probe, commands):
                   "expected linear.x=0, angular.z={z}.").format(
                     side=side, got=describe(turned) if turned else _("nothing new"),
                     z=toward * TURN),
+                _("It turned toward the nearer side: sum or average the valid readings on the "
+                  "left (bearings 0 to 180°, angular.z > 0) and on the right, and turn toward "
+                  "the larger.") if turned is not None and turn_of(turned) == -toward else
                 _("Turn in place (linear.x=0) at ±0.5 rad/s, positive to the left, toward "
                   "the side whose valid readings are farther."))
 
@@ -117,23 +127,43 @@ def test_watchdog_stops(avoider, feeder, probe, commands):
     probe.settle(commands)
     late = window(commands, silent + 0.5 + 0.2 + LATE, probe.now)
     moving = [m for m in late if not is_zero(m)]
-    if moving or len(late) < 13:
+    if moving:
         raise StudentFailure(
-            _("With no scan for 2.5 s of simulation time, cmd_vel from 0.85 s on had "
-              "{count} messages, {moving} of them not a stop ({got}); expected a zero Twist "
-              "on every 10 Hz cycle once 0.5 s pass without a scan.").format(
-                count=len(late), moving=len(moving),
-                got=describe(moving[0]) if moving else "-"),
+            ngettext("With no scan for 2.5 s of simulation time, {moving} of the {count} "
+                     "cmd_vel messages from 0.85 s on was not a stop ({got}); expected a zero "
+                     "Twist on every 10 Hz cycle once 0.5 s pass without a scan.",
+                     "With no scan for 2.5 s of simulation time, {moving} of the {count} "
+                     "cmd_vel messages from 0.85 s on were not a stop ({got}); expected a zero "
+                     "Twist on every 10 Hz cycle once 0.5 s pass without a scan.",
+                     len(moving)).format(count=len(late), moving=len(moving),
+                                         got=describe(moving[0])),
             _("Remember when the last scan came (self.get_clock().now()); in the timer, "
               "publish Twist() when it is more than 0.5 s old."))
+    if len(late) < 13:
+        raise StudentFailure(
+            ngettext("With no scan for 2.5 s of simulation time, cmd_vel was published {count} "
+                     "time from 0.85 s on; expected a zero Twist on every 10 Hz cycle once "
+                     "0.5 s pass without a scan.",
+                     "With no scan for 2.5 s of simulation time, cmd_vel was published {count} "
+                     "times from 0.85 s on; expected a zero Twist on every 10 Hz cycle once "
+                     "0.5 s pass without a scan.", len(late)).format(count=len(late)),
+            _("Publish the stop from the 10 Hz timer on every cycle while the last scan is "
+              "more than 0.5 s old, not once and not from the scan callback."))
     settle_forward(probe, commands, feeder, avoider)
 
 
 @pytest.mark.points(2)
 def test_rejects_malformed_scans(avoider, feeder, probe, commands):
     """An empty scan, or one whose length disagrees with its angles, gives a stop"""
-    for bad, what in ((make_scan(count=0), _("an empty scan")),
-                      (make_scan(count=180), _("a scan of 180 ranges whose angles say 360"))):
+    hints = (_("An empty ranges list shows no obstacle, but no open way either: stop when "
+               "len(scan.ranges) == 0."),
+             _("Its angles say 360 beams and it held 180: before using a scan, check "
+               "len(ranges) == round((angle_max - angle_min) / angle_increment) + 1, and stop "
+               "when it differs."))
+    for (bad, what), hint in zip(
+            ((make_scan(count=0), _("an empty scan")),
+             (make_scan(count=180), _("a scan of 180 ranges whose angles say 360"))),
+            hints, strict=True):
         settle_forward(probe, commands, feeder, avoider)
         since = feeder.feed(bad)
         probe.wait_sim(1.0)
@@ -145,6 +175,7 @@ def test_rejects_malformed_scans(avoider, feeder, probe, commands):
                 _("After {what}, cmd_vel said {got}; expected a zero Twist for that "
                   "cycle.").format(what=what, got=describe(going[0]) if going else
                                    _("nothing")),
+                hint if going else
                 _("Before using a scan, check len(ranges) against (angle_max - angle_min) / "
                   "angle_increment + 1; reject an empty or mismatched scan with a stop."))
     settle_forward(probe, commands, feeder, avoider)
@@ -207,6 +238,9 @@ def test_survives_exceptions(avoider, feeder, probe, commands):
             raise StudentFailure(
                 _("After a scan with {what}, cmd_vel said {got}; expected a zero Twist.")
                 .format(what=what, got=describe(going[0]) if going else _("nothing")),
+                _("It carried on driving: a scan whose angle_increment is 0 or NaN gives no "
+                  "directions to judge. Check angle_increment (and the length of ranges) "
+                  "before use, and stop for that cycle.") if going else
                 _("Wrap the work of each callback in try/except Exception: log the error "
                   "with get_logger().error(...) and publish Twist()."))
     settle_forward(probe, commands, feeder, avoider)

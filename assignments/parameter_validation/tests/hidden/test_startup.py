@@ -1,6 +1,7 @@
 """Hidden tests: an invalid -p override stops the node with a clear error."""
 
 import pytest
+from helpers import RANGES
 
 from autograder.core.errors import StudentFailure
 from autograder.i18n import _
@@ -12,6 +13,8 @@ EXIT_WITHIN = 10.0
 @pytest.mark.points(1)
 def test_invalid_override_exits(start_node):
     """Started with an invalid override, the node exits non-zero naming the parameter"""
+    # Overrides the node did refuse, naming them: proof that its startup check exists.
+    refused_before: list[tuple[str, float]] = []
     for name, value in (("max_linear_speed", 3.0), ("max_angular_speed", -1.0)):
         node = start_node({name: value}, wait_for_node=False)
         code = node.wait_exit(EXIT_WITHIN)
@@ -20,8 +23,7 @@ def test_invalid_override_exits(start_node):
             raise StudentFailure(
                 _("Started with -p {name}:={value}, the node was still running after "
                   "{seconds:.0f} s.").format(name=name, value=value, seconds=EXIT_WITHIN),
-                _("Check the starting values after declare_parameter; log an error and "
-                  "exit with a non-zero status."))
+                _still_running_hint(name, value, refused_before))
         if code == 0:
             raise StudentFailure(
                 _("Started with -p {name}:={value}, the node exited with status 0; a refusal "
@@ -33,3 +35,26 @@ def test_invalid_override_exits(start_node):
                   "{name}. Its last lines:\n{tail}").format(
                     name=name, value=value, tail=node.output_tail(8)),
                 _("Log the problem with `self.get_logger().error(...)`, naming the parameter."))
+        refused_before.append((name, value))
+
+
+def _still_running_hint(name: str, value: float,
+                        refused_before: list[tuple[str, float]]) -> str:
+    """The fix for a node that ran on with an invalid override, by what it did refuse."""
+    if refused_before:
+        low, high = RANGES[name]
+        other, other_value = refused_before[0]
+        if value < low:
+            text = _("Started with -p {other}:={other_value} it did exit, so the starting "
+                     "values are checked, but {name}={value} got through: check the lower "
+                     "bound there too ({name} >= {low}).")
+        else:
+            text = _("Started with -p {other}:={other_value} it did exit, so the starting "
+                     "values are checked, but {name}={value} got through: check the upper "
+                     "bound there too ({name} <= {high}).")
+        return text.format(other=other, other_value=other_value, name=name, value=value,
+                           low=low, high=high)
+    return _("declare_parameter applies the -p overrides before any on-set callback exists, "
+             "so your callback never saw {name}={value}. After declaring, check the "
+             "starting values yourself, log an error naming {name} and return 1 from "
+             "`main()`, ending the file with `sys.exit(main())`.").format(name=name, value=value)

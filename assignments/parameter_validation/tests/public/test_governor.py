@@ -1,10 +1,10 @@
 """Public tests: the node starts, clamps what the agent asks for, answers each input once."""
 
 import pytest
-from helpers import answer, close, exchange, ready, twist
+from helpers import answer, clamp_hint, close, exchange, ready, twist
 
 from autograder.core.errors import StudentFailure
-from autograder.i18n import _
+from autograder.i18n import _, ngettext
 
 
 @pytest.mark.points(1)
@@ -24,7 +24,7 @@ def test_clamps_linear(student, probe, commands):
                 _("The agent asked for linear.x={asked}; cmd_vel had linear.x={got}, "
                   "expected {expected} (max_linear_speed is 0.5).").format(
                     asked=asked, got=got, expected=expected),
-                _("Clamp with `max(-limit, min(limit, value))`."))
+                clamp_hint("linear.x", "max_linear_speed", 0.5, asked, got))
 
 
 @pytest.mark.points(1)
@@ -38,7 +38,7 @@ def test_clamps_angular(student, probe, commands):
                 _("The agent asked for angular.z={asked}; cmd_vel had angular.z={got}, "
                   "expected {expected} (max_angular_speed is 1.0).").format(
                     asked=asked, got=got, expected=expected),
-                _("Clamp angular.z with max_angular_speed, as you do linear.x."))
+                clamp_hint("angular.z", "max_angular_speed", 1.0, asked, got))
 
 
 @pytest.mark.points(1)
@@ -49,9 +49,13 @@ def test_one_output_per_input(student, probe, commands):
         answers = exchange(probe, commands, twist(linear_x=asked))
         if len(answers) != 1:
             raise StudentFailure(
-                _("One agent command gave {count} cmd_vel messages; expected exactly one.")
-                .format(count=len(answers)),
-                _("Publish once per agent/cmd_vel message, from its callback only."))
+                ngettext("The agent's linear.x={asked} gave {count} cmd_vel message; "
+                         "expected exactly one.",
+                         "The agent's linear.x={asked} gave {count} cmd_vel messages; "
+                         "expected exactly one.", len(answers)).format(
+                    asked=asked, count=len(answers)),
+                _("Call publish() once per agent/cmd_vel message, from its callback only: "
+                  "not twice in it, and not from a timer as well."))
 
 
 @pytest.mark.points(1)
@@ -65,7 +69,12 @@ def test_other_fields_zero(student, probe, commands):
               "angular.x": got.angular.x, "angular.y": got.angular.y}
     wrong = {k: v for k, v in others.items() if v != 0.0}
     if wrong:
+        asked = {"linear.y": wish.linear.y, "linear.z": wish.linear.z,
+                 "angular.x": wish.angular.x, "angular.y": wish.angular.y}
+        relayed = all(close(v, asked[k]) for k, v in wrong.items())
         raise StudentFailure(
             _("cmd_vel passed on fields the robot cannot follow: {fields}.").format(
                 fields=", ".join(f"{k}={v}" for k, v in wrong.items())),
-            _("Build a fresh `Twist()` and set only `linear.x` and `angular.z`."))
+            _("These are the agent's own values: its Twist was changed and passed on. "
+              "Build a fresh `Twist()` and set only `linear.x` and `angular.z`.") if relayed
+            else _("Build a fresh `Twist()` and set only `linear.x` and `angular.z`."))

@@ -15,7 +15,9 @@ def test_cruise_speed_override(start_node, probe):
     commands = probe.subscribe(Twist, "/cmd_vel")
     start_node({"cruise_speed": SPEED})
     if not probe.wait_for(lambda: len(commands) >= 5, 5.0):
-        raise StudentFailure(_("Nothing came on cmd_vel within 5 s of simulation time."))
+        raise StudentFailure(
+            _("Nothing came on cmd_vel within 5 s of simulation time."),
+            _("Create a 10 Hz timer whose callback publishes a Twist on cmd_vel."))
     wrong = [m.linear.x for m in commands.messages if abs(m.linear.x - SPEED) > 1e-6]
     if wrong:
         raise StudentFailure(

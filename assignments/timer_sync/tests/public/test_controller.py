@@ -11,15 +11,18 @@ from helpers import (
     PLAN_SECONDS,
     STATUS_PERIOD,
     biggest_gap,
+    blocked_hint,
     freeze_hint,
     parse_status,
     rate_ok,
     require_commands,
     require_not_frozen,
+    too_fast,
+    wall_clock_hint,
 )
 
 from autograder.core.errors import StudentFailure
-from autograder.i18n import _
+from autograder.i18n import _, ngettext
 
 CRUISE = 0.2
 
@@ -54,15 +57,20 @@ def test_control_rate(run):
             freeze_hint())
     if not rate_ok(len(times), seconds, CONTROL_HZ):
         raise StudentFailure(
-            _("cmd_vel came {count} times in {seconds:.1f} s of simulation time "
-              "({rate:.2f} Hz); expected 10 Hz.").format(
+            ngettext("cmd_vel came {count} time in {seconds:.1f} s of simulation time "
+                     "({rate:.2f} Hz); expected 10 Hz.",
+                     "cmd_vel came {count} times in {seconds:.1f} s of simulation time "
+                     "({rate:.2f} Hz); expected 10 Hz.", len(times)).format(
                 count=len(times), seconds=seconds, rate=len(times) / seconds),
+            wall_clock_hint() if too_fast(len(times), seconds, CONTROL_HZ) else
+            blocked_hint(run, gap, where) or
             _("Create the control timer with a period of 0.1 s on the node's clock "
               "(self.create_timer), which follows simulation time."))
     if gap > MAX_GAP:
         raise StudentFailure(
             _("cmd_vel went silent for {gap:.2f} s at t={t:.2f} s of simulation time; no gap "
               "may exceed 0.15 s.").format(gap=gap, t=where),
+            blocked_hint(run, gap, where) or
             _("Something blocked the control timer. Is a slow callback sharing its callback "
               "group or the executor's only thread?"))
 
@@ -115,9 +123,13 @@ def test_status_rate(run):
     gap, where = biggest_gap(times, run.start, run.end)
     if not rate_ok(len(items), seconds, 1.0 / STATUS_PERIOD) or gap > STATUS_PERIOD + 0.1 + 1e-6:
         raise StudentFailure(
-            _("status came {count} times in {seconds:.1f} s of simulation time, with a gap of "
-              "{gap:.2f} s at t={t:.2f}; expected 1 Hz.").format(
+            ngettext("status came {count} time in {seconds:.1f} s of simulation time, with a "
+                     "gap of {gap:.2f} s at t={t:.2f}; expected 1 Hz.",
+                     "status came {count} times in {seconds:.1f} s of simulation time, with a "
+                     "gap of {gap:.2f} s at t={t:.2f}; expected 1 Hz.", len(items)).format(
                 count=len(items), seconds=seconds, gap=gap, t=where),
+            wall_clock_hint() if too_fast(len(items), seconds, 1.0 / STATUS_PERIOD) else
+            blocked_hint(run, gap, where, status=True) or
             _("Create the status timer with a period of 1.0 s on the node's clock."))
 
 
@@ -127,13 +139,18 @@ def test_status_counts(run):
     require_commands(run)
     command_times = [t for t, _m in run.commands]
     plan_times = [t for t, _m in run.plans]
-    items = [(t, parse_status(m)) for t, m in run.status_items()]
-    items = [(t, s) for t, s in items if s is not None]
+    parsed = [(t, m, parse_status(m)) for t, m in run.status_items()]
+    items = [(t, s) for t, _m, s in parsed if s is not None]
     if len(items) < 3:
+        invalid = [m.data for _t, m, s in parsed if s is None]
         raise StudentFailure(
-            _("Only {count} valid status messages came; at least 3 are needed to compare "
-              "counts.").format(count=len(items)),
-            _("Publish status every second as JSON with control_ticks and plans."))
+            ngettext("Only {count} valid status message came; at least 3 are needed to "
+                     "compare counts.",
+                     "Only {count} valid status messages came; at least 3 are needed to "
+                     "compare counts.", len(items)).format(count=len(items)),
+            _("A status such as {text!r} does not count: publish json.dumps of a dict with "
+              "integer control_ticks and plans.").format(text=invalid[0][:200]) if invalid
+            else _("Publish status every second as JSON with control_ticks and plans."))
     # control_ticks counts from the node's start; the probe may have missed the first
     # few, so what must hold is a constant difference (one message either side: stamps).
     offsets = [s["control_ticks"] - sum(1 for c in command_times if c <= t) for t, s in items]
@@ -141,22 +158,50 @@ def test_status_counts(run):
     if high - low > 2 or low < -2:
         worst = max(range(len(items)), key=lambda i: abs(offsets[i] - offsets[0]))
         t, s = items[worst]
+        seen = sum(1 for c in command_times if c <= t)
         raise StudentFailure(
-            _("At t={t:.2f} s status said control_ticks={ticks}, but cmd_vel had come {seen} "
-              "times by then; control_ticks must count every control callback since the "
-              "node started.").format(t=t, ticks=s["control_ticks"],
-                                      seen=sum(1 for c in command_times if c <= t)),
-            _("Increment one counter in the control callback and report it as is; do not "
-              "reset it."))
+            ngettext("At t={t:.2f} s status said control_ticks={ticks}, but cmd_vel had come "
+                     "{seen} time by then; control_ticks must count every control callback "
+                     "since the node started.",
+                     "At t={t:.2f} s status said control_ticks={ticks}, but cmd_vel had come "
+                     "{seen} times by then; control_ticks must count every control callback "
+                     "since the node started.", seen).format(
+                t=t, ticks=s["control_ticks"], seen=seen),
+            _ticks_hint(items, command_times))
     for t, s in items:
         if any(abs(t - p) <= 0.2 for p in plan_times):
             continue  # a status beside a plan may count it or not yet
         seen = sum(1 for p in plan_times if p <= t)
         if s["plans"] != seen:
             raise StudentFailure(
-                _("At t={t:.2f} s status said plans={plans}, but {seen} plans had been "
-                  "published by then.").format(t=t, plans=s["plans"], seen=seen),
+                ngettext("At t={t:.2f} s status said plans={plans}, but {seen} plan had been "
+                         "published by then.",
+                         "At t={t:.2f} s status said plans={plans}, but {seen} plans had been "
+                         "published by then.", seen).format(t=t, plans=s["plans"], seen=seen),
+                _("The node counts plans that never came on plan: publish each route on plan "
+                  "(a std_msgs/String) when the planner finishes it, and count it then.")
+                if s["plans"] > seen else
                 _("Count a plan when the planner finishes one and report the count."))
+
+
+def _ticks_hint(items: list[tuple[float, dict[str, int]]], command_times: list[float]) -> str:
+    """A counter that does not grow with cmd_vel was reset; otherwise it counts something
+    else than the control callbacks."""
+    (first_t, first), (last_t, last) = items[0], items[-1]
+    came = sum(1 for c in command_times if first_t < c <= last_t)
+    grew = last["control_ticks"] - first["control_ticks"]
+    if grew < came / 2:
+        return ngettext(
+            "control_ticks went from {first} at t={a:.2f} s to {last} at t={b:.2f} s while "
+            "cmd_vel came {came} time: the counter is reset somewhere. Count every control "
+            "callback since the node started, and never reset it.",
+            "control_ticks went from {first} at t={a:.2f} s to {last} at t={b:.2f} s while "
+            "cmd_vel came {came} times: the counter is reset somewhere. Count every control "
+            "callback since the node started, and never reset it.", came).format(
+            first=first["control_ticks"], a=first_t, last=last["control_ticks"], b=last_t,
+            came=came)
+    return _("Increment one counter in the control callback and report it as is; do not "
+             "reset it.")
 
 
 @pytest.mark.points(2)
@@ -166,19 +211,34 @@ def test_plan_rate(run):
     plans = run.plan_times()
     seconds = run.end - run.start
     if len(plans) < 2:
+        counted = max((s["plans"] for s in map(parse_status, (m for _t, m in run.statuses))
+                       if s is not None), default=0)
+        if run.frozen_at is not None:
+            hint = freeze_hint()
+        elif counted > len(plans):
+            hint = _("status reported plans={counted}, so the planner runs, but its routes do "
+                     "not come on plan: publish each one there as a std_msgs/String.").format(
+                counted=counted)
+        else:
+            hint = _("Create a 10 s timer that calls plan_route() and publishes the result on "
+                     "plan.")
         raise StudentFailure(
-            _("{count} plans came in {seconds:.1f} s of simulation time; expected one every "
-              "10 s.").format(count=len(plans), seconds=seconds),
-            freeze_hint() if run.frozen_at is not None else
-            _("Create a 10 s timer that calls plan_route() and publishes the result on plan."))
+            ngettext("{count} plan came in {seconds:.1f} s of simulation time; expected one "
+                     "every 10 s.",
+                     "{count} plans came in {seconds:.1f} s of simulation time; expected one "
+                     "every 10 s.", len(plans)).format(count=len(plans), seconds=seconds),
+            hint)
     intervals = [b - a for a, b in zip(plans, plans[1:], strict=False)]
     wrong = [d for d in intervals if abs(d - PLAN_PERIOD) > 0.25]
     if wrong or len(plans) > seconds / PLAN_PERIOD + 1:
         raise StudentFailure(
-            _("Plans came {count} times in {seconds:.1f} s of simulation time, {apart} s "
-              "apart; expected every 10 s.").format(
+            ngettext("Plans came {count} time in {seconds:.1f} s of simulation time, {apart} s "
+                     "apart; expected every 10 s.",
+                     "Plans came {count} times in {seconds:.1f} s of simulation time, {apart} "
+                     "s apart; expected every 10 s.", len(plans)).format(
                 count=len(plans), seconds=seconds,
                 apart=", ".join(f"{d:.2f}" for d in intervals)),
+            wall_clock_hint() if any(d < PLAN_PERIOD - 0.25 for d in intervals) else
             _("Create the planner timer with a period of 10.0 s on the node's clock."))
 
 
@@ -192,10 +252,13 @@ def test_rates_at_half_speed(run):
     statuses = [t for t, _m in run.status_items() if t >= run.switch]
     if not rate_ok(len(commands), seconds, CONTROL_HZ) or \
             not rate_ok(len(statuses), seconds, 1.0 / STATUS_PERIOD):
+        fast = too_fast(len(commands), seconds, CONTROL_HZ) or \
+            too_fast(len(statuses), seconds, 1.0 / STATUS_PERIOD)
+        gap, where = biggest_gap(commands, run.switch, run.end)
         raise StudentFailure(
             _("With the world at half speed, cmd_vel came at {control:.1f} Hz and status at "
               "{status:.1f} Hz in simulation time; expected 10 Hz and 1 Hz.").format(
                 control=len(commands) / seconds, status=len(statuses) / seconds),
-            _("Time everything with the node's timers (self.create_timer) and clock "
-              "(self.get_clock()), never time.sleep or time.time: with use_sim_time they "
-              "follow /clock, whatever its pace."))
+            wall_clock_hint() if fast else blocked_hint(run, gap, where) or
+            _("Something blocked the control timer. Is a slow callback sharing its callback "
+              "group or the executor's only thread?"))
