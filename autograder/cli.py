@@ -115,33 +115,36 @@ def start(exercise: str, directory: Path | None) -> None:
 def _run(exercise: str, submission: Path, hidden: bool, outputs: dict[str, Path | None],
          rtf: float | None, domain: int | None) -> None:
     from autograder.core.report import RawTest
-    from autograder.core.results import TestResult, exact
     from autograder.core.submission import SubmissionNotFound, locate
-    from autograder.grading.run import grade
-    from autograder.render.terminal import for_terminal, rtl_notice, test_line, to_terminal
+    from autograder.grading.run import grade, result_of
+    from autograder.render.live import LiveLines, terminal_style
+    from autograder.render.terminal import for_terminal, heading, rtl_notice, to_terminal
 
     found = _exercise(exercise)
     try:
         locate(submission, found.file)
     except SubmissionNotFound as exc:
         raise UsageProblem(str(exc)) from None
-    color = sys.stdout.isatty()
+    color, in_place = terminal_style(sys.stdout)
+    # Every test line once, on stdout as the tests end; the summary after them adds the
+    # failures and the score (and the lines of tests that never ended).
+    live = LiveLines(lambda text: click.echo(text, nl=False), color, in_place)
 
-    def progress(raw: RawTest) -> None:
-        score = exact(raw.max_score) if raw.status == "passed" else exact(0)
-        click.echo(test_line(TestResult(
-            name=raw.name, label=raw.label, score=score, max_score=exact(raw.max_score),
-            status=raw.status, message=raw.message, visibility=raw.visibility), color,
-            reveal=False), err=True)
+    def running(raw: RawTest | None) -> None:
+        live.running(raw.nodeid if raw else None, raw.label if raw else "")
 
     notice = rtl_notice(html=outputs.get("html"))
     if notice:
         click.echo(notice, err=True)
     click.echo(for_terminal(_("Grading {file} for {exercise} in the simulator...").format(
         file=submission, exercise=found.id)), err=True)
-    result = grade(found, submission, hidden=hidden, domain=domain, real_time_factor=rtf,
-                   progress=progress)
-    click.echo(to_terminal(result, color=color))
+    click.echo(heading(found.id, found.localized_title, color) + "\n")
+    try:
+        result = grade(found, submission, hidden=hidden, domain=domain, real_time_factor=rtf,
+                       progress=lambda raw: live.done(result_of(raw)), running=running)
+    finally:
+        live.close()
+    click.echo(to_terminal(result, color=color, shown=live.shown, with_heading=False))
     write_outputs(result, outputs, found.folder)
     if result.grader_error:
         raise GraderFault(result.grader_error)
