@@ -131,6 +131,13 @@ class QuestionType(abc.ABC):
                 score=format_number(earned, lang), max=format_number(points, lang))
         return _("Incorrect.")
 
+    def answer_text(self, quiz: Quiz, q: Question, value: Any, loc: Localizer) -> str:
+        """A checked answer (never None) as the student reads it back in a terminal: the
+        texts of the options it names, in its order."""
+        texts = {v.id: terminal(v.text) for v in self.option_views(quiz, q, None, loc)}
+        chosen = value if isinstance(value, list) else [value]
+        return ", ".join(texts.get(str(c), str(c)) for c in chosen)
+
     # One attempt ------------------------------------------------------------------------
 
     def option_order(self, quiz: Quiz, q: Question, seed: str | int | None) -> tuple[Option, ...]:
