@@ -16,7 +16,7 @@ import click
 from autograder import __version__
 from autograder.commands.exits import GraderFault, UsageProblem, report_problems
 from autograder.core.errors import ContentError
-from autograder.i18n import LANGUAGES, _, get_language, set_language
+from autograder.i18n import LANGUAGES, _, get_language, ngettext, set_language
 from autograder.i18n.cli import i18n_cli
 from autograder.quiz.cli import quiz_cli
 from sim.cli import sim_cli
@@ -278,7 +278,8 @@ def grade_batch(item: str, submissions: Path, jobs: int, csv_path: Path, out: Pa
 
     rows = run_batch(students(submissions, suffix), grade_one, out, csv_path, jobs=jobs,
                      shard=share, extra=extra, progress=progress)
-    click.echo(_("{count} rows in {path}").format(count=len(rows), path=csv_path))
+    click.echo(ngettext("{count} row in {path}", "{count} rows in {path}", len(rows)).format(
+        count=len(rows), path=csv_path))
 
 
 def _batch_item(item: str):  # noqa: ANN202
@@ -333,7 +334,8 @@ def gradebook_merge(out: Path, inputs: tuple[Path, ...]) -> None:
     except ContentError as exc:
         raise UsageProblem(str(exc)) from None
     gradebook.write(out, rows)
-    click.echo(_("{count} rows in {path}").format(count=len(rows), path=out))
+    click.echo(ngettext("{count} row in {path}", "{count} rows in {path}", len(rows)).format(
+        count=len(rows), path=out))
 
 
 @main.command()

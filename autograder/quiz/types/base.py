@@ -13,7 +13,7 @@ from collections.abc import Mapping
 from fractions import Fraction
 from typing import TYPE_CHECKING, Any, ClassVar
 
-from autograder.i18n import _
+from autograder.i18n import _, ngettext
 from autograder.quiz.localize import Localizer, format_number, terminal
 from autograder.quiz.model import Option, Question, Quiz, check_id
 from autograder.quiz.shuffle import attempt_rng, shuffle_unpinned
@@ -127,7 +127,8 @@ class QuestionType(abc.ABC):
         if earned == points:
             return _("Correct.")
         if earned:
-            return _("Partly correct: {score} of {max} points.").format(
+            return ngettext("Partly correct: {score} of {max} point.",
+                            "Partly correct: {score} of {max} points.", q.points).format(
                 score=format_number(earned, lang), max=format_number(points, lang))
         return _("Incorrect.")
 
