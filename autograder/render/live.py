@@ -17,7 +17,7 @@ from typing import TextIO
 
 from autograder.core.results import TestResult
 from autograder.i18n import _
-from autograder.render.terminal import for_terminal, test_key, test_line
+from autograder.render.terminal import for_terminal, line_key, test_line
 
 _CLEAR = "\r\x1b[2K"  # back to the line's start, and erase it
 
@@ -44,7 +44,7 @@ class LiveLines:
         self.in_place = in_place
         self._clock = clock
         self._width = width
-        self.shown: set[str] = set()  # test_key of every line printed
+        self.shown: set[str] = set()  # line_key of every line printed
         self._running: tuple[str, float] | None = None  # the running test, since when
         self._drawn = ""  # what the running line shows now ("" if none)
 
@@ -67,7 +67,7 @@ class LiveLines:
         self._draw("")
         self._running = None
         self._write(test_line(test, self.color) + "\n")
-        self.shown.add(test_key(test))
+        self.shown.add(line_key(test))
 
     def close(self) -> None:
         """Erase the running line, if any, before the summary."""

@@ -71,6 +71,7 @@ def rtl_notice(lang: str | None = None, html: Path | None = None,
                  "browser.")
     return for_terminal(text, lang)
 
+
 _MARKS = {"passed": ("✔", "green"), "failed": ("✘", "red"), "error": ("!", "yellow"),
           "skipped": ("-", "yellow")}
 _INDENT = "    "
@@ -159,7 +160,7 @@ def to_terminal(result: RunResult, color: bool = False, shown: Collection[str] =
     they ran: see :mod:`autograder.render.live`), each failure once with its message and
     hint, then the score and what it proves."""
     lines = [heading(result.id, result.title, color), ""] if with_heading else []
-    lines += [test_line(t, color) for t in result.tests if test_key(t) not in shown]
+    lines += [test_line(t, color) for t in result.tests if line_key(t) not in shown]
     for block in filter(None, (failure_block(t, color) for t in result.tests)):
         lines += ["", block]
     lines += ["", *score_lines(result, color)]
@@ -174,6 +175,6 @@ def to_terminal(result: RunResult, color: bool = False, shown: Collection[str] =
     return for_terminal("\n".join(lines), result.lang)
 
 
-def test_key(test: TestResult) -> str:
+def line_key(test: TestResult) -> str:
     """What tells a test from the others in a run (its node id when the run knows it)."""
     return str(test.data.get("nodeid") or test.name)
