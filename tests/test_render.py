@@ -120,6 +120,26 @@ def test_terminal_says_each_thing_once():
     assert SECRET not in text
 
 
+def test_failures_with_the_same_hint_stand_together_under_it_once():
+    """timer_sync's starter fails four tests for one cause: its hint is said once."""
+    planner = "The planner blocks for 2 s.\nGive it a callback group of its own."
+
+    def failed(name: str, message: str, hint: str) -> TestResult:
+        return TestResult(name, f"{name} label", Fraction(0), Fraction(1), "failed",
+                          message=message, hint=hint)
+
+    run = RunResult("exercise", "timer_sync", "T", (
+        failed("test_rate", "cmd_vel stopped", planner),
+        failed("test_status", "no status", "Create a 1 s timer."),
+        failed("test_plan", "no plan", planner)))
+    text = to_terminal(run)
+    assert text.count("The planner blocks for 2 s.") == 1
+    assert ("✘ test_rate label\n    cmd_vel stopped\n✘ test_plan label\n    no plan\n"
+            "    Hint for the 2 failures above: The planner blocks for 2 s.\n"
+            "    Give it a callback group of its own.\n\n✘ test_status label\n    no status\n"
+            "    Hint: Create a 1 s timer.") in text
+
+
 def test_terminal_leaves_out_the_lines_already_shown():
     shown = {"test_starts", "test_rate"}
     text = to_terminal(result(), shown=shown, with_heading=False)

@@ -13,13 +13,13 @@ from __future__ import annotations
 
 import re
 import unicodedata
-from collections.abc import Collection
+from collections.abc import Collection, Iterable
 from pathlib import Path
 
 from babel.numbers import format_percent
 
 from autograder.core.results import RunResult, TestResult, as_decimal, number
-from autograder.i18n import _, get_language, is_rtl
+from autograder.i18n import _, get_language, is_rtl, ngettext
 
 RLM = "\u200f"
 _ANSI = re.compile(r"\x1b\[[0-9;]*[A-Za-z]")
@@ -92,7 +92,7 @@ def heading(exercise: str, title: str, color: bool = False) -> str:
 
 def test_line(test: TestResult, color: bool = False) -> str:
     """A test in one line: its mark, its points and its label (what went wrong comes once,
-    in :func:`failure_block`)."""
+    in :func:`failure_blocks`)."""
     mark, tint = _MARKS[test.status]
     points = f"{number(test.score)}/{number(test.max_score)}"
     return for_terminal(f" {_style(mark, tint, color)} {points:>5}  {test.label}")
@@ -102,18 +102,30 @@ def _indented(text: str) -> list[str]:
     return [(_INDENT + line).rstrip() for line in text.strip("\n").splitlines()]
 
 
-def failure_block(test: TestResult, color: bool = False) -> str | None:
-    """What a failed (or skipped) test says, once: its label, its message (the program's
-    last lines within it) and its hint, as far as the test reveals them; None if it
-    reveals nothing but its line."""
-    message, hint = test.student_message.strip(), test.student_hint.strip()
-    if test.status not in ("failed", "skipped") or not (message or hint):
-        return None
-    mark, tint = _MARKS[test.status]
-    lines = [_style(f"{mark} {test.label}", tint, color, bold=True), *_indented(message)]
-    if hint:
-        lines += _indented(_("Hint: {hint}").format(hint=hint))
-    return "\n".join(lines)
+def failure_blocks(tests: Iterable[TestResult], color: bool = False) -> list[str]:
+    """What the failed (and skipped) tests say, each once: its label and its message (the
+    program's last lines within it), as far as the test reveals them. Failures with the
+    same hint stand together, in the order of the first, under that hint said once: one
+    cause, several symptoms."""
+    groups: dict[str, list[TestResult]] = {}
+    for test in tests:
+        message, hint = test.student_message.strip(), test.student_hint.strip()
+        if test.status in ("failed", "skipped") and (message or hint):
+            groups.setdefault(hint or f"\0{line_key(test)}", []).append(test)
+    blocks = []
+    for hint, group in groups.items():
+        lines = []
+        for test in group:
+            mark, tint = _MARKS[test.status]
+            lines += [_style(f"{mark} {test.label}", tint, color, bold=True),
+                      *_indented(test.student_message)]
+        if not hint.startswith("\0"):
+            said = _("Hint: {hint}") if len(group) == 1 else ngettext(
+                "Hint for the failure above: {hint}", "Hint for the {count} failures above: "
+                "{hint}", len(group))
+            lines += _indented(said.format(hint=hint, count=len(group)))
+        blocks.append("\n".join(lines))
+    return blocks
 
 
 def score_lines(result: RunResult, color: bool = False) -> list[str]:
@@ -161,7 +173,7 @@ def to_terminal(result: RunResult, color: bool = False, shown: Collection[str] =
     hint, then the score and what it proves."""
     lines = [heading(result.id, result.title, color), ""] if with_heading else []
     lines += [test_line(t, color) for t in result.tests if line_key(t) not in shown]
-    for block in filter(None, (failure_block(t, color) for t in result.tests)):
+    for block in failure_blocks(result.tests, color):
         lines += ["", block]
     lines += ["", *score_lines(result, color)]
     isolation = result.data.get("isolation", {})
