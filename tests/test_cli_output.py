@@ -2,10 +2,10 @@
 English and Urdu, on parameter_validation's starter and reference.
 
 Each test's line appears once, each failure's message once and each hint once (failures
-that share one stand together under it), the student's file
-is named as they gave it (never the grader's throwaway copy), ``check`` says what it proved
-and never "passed", and on a terminal the running test is redrawn in place while each
-test's final line is still printed once. The runs are real ones (the CLI in a process of
+that share one stand together under it), the student's file is named as they gave it
+(never the grader's throwaway copy), ``check`` says what it proved and never "passed", and
+on a terminal the running test is redrawn in place while each test's final line is still
+printed once. The runs are real ones (the CLI in a process of
 its own, grading in the simulator), two at a time, as the exercises' proofs run.
 """
 
