@@ -17,7 +17,7 @@ from autograder import __version__
 from autograder.commands.exits import GraderFault, UsageProblem, report_problems
 from autograder.commands.sim_node import add_node_options
 from autograder.core.errors import ContentError
-from autograder.i18n import LANGUAGES, _, get_language, set_language
+from autograder.i18n import LANGUAGES, _, get_language, ngettext, set_language
 from autograder.i18n.cli import i18n_cli
 from autograder.quiz.cli import quiz_cli
 from sim.cli import sim_cli
@@ -120,33 +120,37 @@ def start(exercise: str, directory: Path | None) -> None:
 def _run(exercise: str, submission: Path, hidden: bool, outputs: dict[str, Path | None],
          rtf: float | None, domain: int | None, record: Path | None = None) -> None:
     from autograder.core.report import RawTest
-    from autograder.core.results import TestResult, exact
     from autograder.core.submission import SubmissionNotFound, locate
-    from autograder.grading.run import grade
-    from autograder.render.terminal import for_terminal, rtl_notice, test_line, to_terminal
+    from autograder.grading.run import grade, result_of
+    from autograder.render.live import LiveLines, terminal_style
+    from autograder.render.terminal import for_terminal, heading, rtl_notice, to_terminal
 
     found = _exercise(exercise)
     try:
         locate(submission, found.file)
     except SubmissionNotFound as exc:
         raise UsageProblem(str(exc)) from None
-    color = sys.stdout.isatty()
+    color, in_place = terminal_style(sys.stdout)
+    # Every test line once, on stdout as the tests end; the summary after them adds the
+    # failures and the score (and the lines of tests that never ended).
+    live = LiveLines(lambda text: click.echo(text, nl=False), color, in_place)
 
-    def progress(raw: RawTest) -> None:
-        score = exact(raw.max_score) if raw.status == "passed" else exact(0)
-        click.echo(test_line(TestResult(
-            name=raw.name, label=raw.label, score=score, max_score=exact(raw.max_score),
-            status=raw.status, message=raw.message, visibility=raw.visibility), color,
-            reveal=False), err=True)
+    def running(raw: RawTest | None) -> None:
+        live.running(raw.nodeid if raw else None, raw.label if raw else "")
 
     notice = rtl_notice(html=outputs.get("html"))
     if notice:
         click.echo(notice, err=True)
     click.echo(for_terminal(_("Grading {file} for {exercise} in the simulator...").format(
         file=submission, exercise=found.id)), err=True)
-    result = grade(found, submission, hidden=hidden, domain=domain, real_time_factor=rtf,
-                   progress=progress, record=record)
-    click.echo(to_terminal(result, color=color))
+    click.echo(heading(found.id, found.localized_title, color) + "\n")
+    try:
+        result = grade(found, submission, hidden=hidden, domain=domain, real_time_factor=rtf,
+                       progress=lambda raw: live.done(result_of(raw)), running=running,
+                       record=record)
+    finally:
+        live.close()
+    click.echo(to_terminal(result, color=color, shown=live.shown, with_heading=False))
     _say_recorded(result, record)
     write_outputs(result, outputs, found.folder)
     if result.grader_error:
@@ -303,7 +307,8 @@ def grade_batch(item: str, submissions: Path, jobs: int, csv_path: Path, out: Pa
 
     rows = run_batch(students(submissions, suffix), grade_one, out, csv_path, jobs=jobs,
                      shard=share, extra=extra, progress=progress)
-    click.echo(_("{count} rows in {path}").format(count=len(rows), path=csv_path))
+    click.echo(ngettext("{count} row in {path}", "{count} rows in {path}", len(rows)).format(
+        count=len(rows), path=csv_path))
 
 
 def _batch_item(item: str, record: Path | None = None):  # noqa: ANN202
@@ -366,7 +371,8 @@ def gradebook_merge(out: Path, inputs: tuple[Path, ...]) -> None:
     except ContentError as exc:
         raise UsageProblem(str(exc)) from None
     gradebook.write(out, rows)
-    click.echo(_("{count} rows in {path}").format(count=len(rows), path=out))
+    click.echo(ngettext("{count} row in {path}", "{count} rows in {path}", len(rows)).format(
+        count=len(rows), path=out))
 
 
 @main.command()

@@ -115,7 +115,9 @@ def test_urdu_summary_lines_start_right_to_left() -> None:
     lines = to_terminal(_urdu_run()).split("\n")
     assert lines[0] == RLM + "parameter_validation — Parameter validation: ایک governor"
     assert lines[2].startswith(RLM + " ✔") and lines[3].startswith(RLM + " ✘")
-    assert "\n          Traceback (most recent call last):" in to_terminal(_urdu_run())
+    # The failure's block: its label, then the program's output as it is, left to right.
+    assert lines[5] == RLM + "✘ cmd_vel دس Hz پر رہتا ہے"
+    assert lines[6] == "    Traceback (most recent call last):"
 
 
 def test_check_in_urdu_marks_lines_and_points_to_the_report(
@@ -125,7 +127,9 @@ def test_check_in_urdu_marks_lines_and_points_to_the_report(
     def fake_grade(exercise, submission, *, progress=None, **_kw):  # noqa: ANN001, ANN202
         progress(RawTest("t.py::test_starts", "test_starts", "node شروع ہوتا ہے", 1,
                          "visible", "all", True, "passed"))
-        return dataclasses.replace(_urdu_run(), lang=get_language())
+        run = _urdu_run()
+        started = dataclasses.replace(run.tests[0], data={"nodeid": "t.py::test_starts"})
+        return dataclasses.replace(run, lang=get_language(), tests=(started, *run.tests[1:]))
 
     monkeypatch.setattr("autograder.grading.run.grade", fake_grade)
     starter = REPO / "assignments" / "parameter_validation" / "starter" / "velocity_governor.py"
@@ -134,8 +138,8 @@ def test_check_in_urdu_marks_lines_and_points_to_the_report(
                                        "--lang", "ur", "--html", str(report)])
     assert result.exit_code == 0, result.output
     assert result.stderr.split("\n")[0].count(str(report)) == 1  # the notice, first
-    assert RLM + " ✔" in result.stderr  # the progress line
     assert result.stdout.startswith(RLM + "parameter_validation — ")
+    assert result.stdout.count(RLM + " ✔") == 1  # the test's line, printed as it ended
     assert report.read_text().startswith("<!doctype html>")
     english = CliRunner().invoke(main, ["check", "parameter_validation", str(starter),
                                         "--lang", "en"])

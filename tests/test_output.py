@@ -99,8 +99,9 @@ def test_log_names():
 
 
 class FakeProcess:
-    def __init__(self, output: _Output) -> None:
+    def __init__(self, output: _Output, workdir: Path = Path("/tmp/autograder-student-x1")) -> None:
         self.output = output
+        self.workdir = workdir
 
     def output_text(self) -> str:
         return self.output.text()
@@ -120,6 +121,25 @@ def test_a_nodes_tail_is_short_and_says_it_was_cut():
     assert tail.splitlines()[-2] == "RuntimeError: the end"
     assert "only the first and last 512 bytes were kept" in tail.splitlines()[-1]
     assert "HEAD" not in tail and utf8(tail) <= TAIL_BYTES + 200
+
+
+@pytest.mark.parametrize(("submitted", "shown"), [
+    ("mywork/obstacle_avoider.py", 'File "mywork/obstacle_avoider.py", line 55, in on_scan'),
+    ("obstacle_avoider.py", 'File "obstacle_avoider.py", line 55, in on_scan'),
+    (None, 'File "obstacle_avoider.py", line 55, in on_scan')], ids=["folder", "bare", "none"])
+def test_a_traceback_names_the_students_file_not_the_throwaway_copy(submitted, shown):
+    from autograder.plugin.student import _shown_folder
+
+    output = _Output(4096)
+    output.feed(b'Traceback (most recent call last):\n'
+                b'  File "/tmp/autograder-student-x1/obstacle_avoider.py", line 55, in on_scan\n'
+                b'  File "/tmp/autograder-student-x1/helpers.py", line 3, in ahead\n'
+                b'ValueError: min() arg is an empty sequence\n')
+    node = StudentNode(FakeProcess(output), "obstacle_avoider", probe=None,
+                       shown_folder=_shown_folder(submitted))
+    assert shown in node.output() and shown in node.output_tail()
+    assert "/tmp/autograder-student-x1" not in node.output()
+    assert 'helpers.py", line 3' in node.output()  # a sibling module: the same folder
 
 
 def test_the_whole_log_goes_beside_the_report_once(tmp_path):

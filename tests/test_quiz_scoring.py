@@ -181,6 +181,56 @@ def test_score_cli_writes_results_in_urdu(tmp_path: Path) -> None:
     assert "ابھی کامیاب نہیں" in cli.output
 
 
+def test_score_cli_speaks_the_answers_files_language_unless_told(tmp_path: Path) -> None:
+    """An answers file saved in Urdu is scored in Urdu; --lang (here or on autograder)
+    wins."""
+    from autograder.cli import main
+
+    answers = {"quiz": "rclpy-part2", "lang": "ur", "answers": {"gil": "ros-lock"}}
+    path = _write(tmp_path, json.dumps(answers))
+    results = tmp_path / "results.json"
+    urdu = CliRunner().invoke(quiz_cli, ["score", "rclpy-part2", str(path),
+                                         "--results", str(results)])
+    assert urdu.exit_code == 0, urdu.output
+    assert "ابھی کامیاب نہیں" in urdu.stdout and "Not passed yet" not in urdu.stdout
+    assert json.loads(results.read_text())["lang"] == "ur"
+    english = CliRunner().invoke(quiz_cli, ["score", "rclpy-part2", str(path), "--lang", "en"])
+    assert "Not passed yet" in english.stdout
+    on_main = CliRunner().invoke(main, ["--lang", "en", "quiz", "score", "rclpy-part2",
+                                        str(path)])
+    assert on_main.exit_code == 0, on_main.output
+    assert "Not passed yet" in on_main.stdout
+
+
+def test_score_cli_shows_each_question_and_the_answer_given(tmp_path: Path) -> None:
+    answers = {"quiz": "rclpy-part2", "answers": {"gil": "ros-lock",
+                                                  "declare-parameters": "declare"}}
+    path = _write(tmp_path, json.dumps(answers))
+    cli = CliRunner().invoke(quiz_cli, ["score", "rclpy-part2", str(path), "--lang", "en"])
+    lines = cli.stdout.splitlines()
+    assert " ✘ 3. What is the Global Interpreter Lock (GIL)? (0/1)" in lines
+    assert ("      Incorrect. Your answer: A lock that ROS 2 puts on each topic so that two "
+            "nodes cannot publish …") in lines
+    assert " ✔ 2. How do you declare a parameter in a Python ROS 2 node? (1/1)" in lines
+    assert " ✘ 1. What is the main purpose of callback groups in rclpy? (0/1)" in lines
+    assert lines[lines.index(" ✘ 1. What is the main purpose of callback groups in rclpy? "
+                             "(0/1)") + 1] == "      Not answered."
+    assert all(len(line) < 120 for line in lines if line.startswith(" ✘") or
+               "Your answer" in line)
+
+
+@pytest.mark.parametrize(("question", "answer", "text"), [
+    ("tf", False, "False"), ("tf", "true", "True"), ("num", 0.355, "0.355"),
+    ("all-or-nothing", ["b", "a"], "B, A"), ("order", ["z", "x", "y"], "Z, X, Y")])
+def test_an_answer_reads_back_as_the_student_chose_it(question, answer, text) -> None:
+    from autograder.quiz.localize import Localizer
+    from autograder.quiz.types import question_type
+
+    quiz = load_quiz("types.yaml", TYPES).quiz
+    q = quiz.question(question)
+    assert question_type(q.type).answer_text(quiz, q, answer, Localizer(quiz, "en")) == text
+
+
 def test_key_cli_prints_a_full_marks_answers_file(tmp_path: Path) -> None:
     key = CliRunner().invoke(quiz_cli, ["key", "error-handling"])
     path = _write(tmp_path, key.output)

@@ -68,7 +68,7 @@ def test_ordering_numeric_and_multiple_from_the_form(server: QuizServer) -> None
               ("q:keep-in-step", "same-group"), ("q:keep-in-step", "lock")]
     status, page = _post(server.url + "quiz/timer-synchronization/submit", fields)
     assert status == 200 and page.count("Correct.") == 2  # Urdu digits parse as numbers
-    assert "Partly correct: 0.67 of 1 points." in page
+    assert "Partly correct: 0.67 of 1 point." in page
     order = [("q:life-order:init", "1"), ("q:life-order:create", "2"),
              ("q:life-order:spin", "3"), ("q:life-order:destroy", "4"),
              ("q:life-order:shutdown", "5")]

@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
+import re
 import xml.etree.ElementTree as ET
 from fractions import Fraction
 
 import pytest
 
-from autograder.core.results import RunResult, TestResult
+from autograder.core.results import NotRun, RunResult, TestResult
 from autograder.i18n import set_language
 from autograder.render.gradescope import to_gradescope, to_gradescope_dict
 from autograder.render.html import to_html
@@ -103,6 +105,80 @@ def test_terminal_has_a_line_per_test_and_the_verdict():
     for label in ("The node starts", "cmd_vel keeps 10 Hz", "Refuses bad values"):
         assert label in text
     assert "Score: 2.5/7" in text and "not passed" in text
+
+
+def test_terminal_says_each_thing_once():
+    """A line per test, then each failure once: its message and its hint; a hidden test's
+    message and hint stay hidden, as in every other format."""
+    text = to_terminal(result())
+    for label in ("The node starts", "Refuses bad values", "Exits on a bad override"):
+        assert len(re.findall(rf"^ . +[\d.]+/\d  {label}$", text, re.M)) == 1, text
+    assert text.count("cmd_vel keeps 10 Hz") == 2  # its line, and its failure's heading
+    assert text.count("`cmd_vel` came at 3.1 Hz") == 1
+    assert text.count("Hint: Is the planner in its own callback group?") == 1
+    assert text.count("covered half the way") == 1
+    assert SECRET not in text
+
+
+def test_failures_with_the_same_hint_stand_together_under_it_once():
+    """timer_sync's starter fails four tests for one cause: its hint is said once."""
+    planner = "The planner blocks for 2 s.\nGive it a callback group of its own."
+
+    def failed(name: str, message: str, hint: str) -> TestResult:
+        return TestResult(name, f"{name} label", Fraction(0), Fraction(1), "failed",
+                          message=message, hint=hint)
+
+    run = RunResult("exercise", "timer_sync", "T", (
+        failed("test_rate", "cmd_vel stopped", planner),
+        failed("test_status", "no status", "Create a 1 s timer."),
+        failed("test_plan", "no plan", planner)))
+    text = to_terminal(run)
+    assert text.count("The planner blocks for 2 s.") == 1
+    assert ("✘ test_rate label\n    cmd_vel stopped\n✘ test_plan label\n    no plan\n"
+            "    Hint for the 2 failures above: The planner blocks for 2 s.\n"
+            "    Give it a callback group of its own.\n\n✘ test_status label\n    no status\n"
+            "    Hint: Create a 1 s timer.") in text
+
+
+def test_terminal_leaves_out_the_lines_already_shown():
+    shown = {"test_starts", "test_rate"}
+    text = to_terminal(result(), shown=shown, with_heading=False)
+    assert not text.startswith("timer_sync")
+    assert " ✔   1/1  The node starts" not in text
+    assert " ✘   0/2  cmd_vel keeps 10 Hz" not in text
+    assert " ✘   0/2  Refuses bad values" in text  # not shown yet: printed here
+    assert text.count("Hint: Is the planner in its own callback group?") == 1
+
+
+@pytest.mark.parametrize(("not_run", "says"), [
+    (NotRun(8, Fraction(9)), "The grade also runs 8 hidden tests (9 points)."),
+    (NotRun(1, Fraction(1)), "The grade also runs 1 hidden test (1 point)."),
+    (NotRun(None, Fraction(3, 2)), "The grade also runs hidden tests (1.5 points)."),
+    (NotRun(), "The grade also runs hidden tests.")], ids=["both", "one", "points", "unknown"])
+def test_a_partial_run_says_what_it_proved_and_gives_no_verdict(not_run, says):
+    partial = dataclasses.replace(result(), not_run=not_run)
+    text = to_terminal(partial)
+    assert "Public tests: 2.5/7 (36%)." in text and says in text
+    assert "Score:" not in text and "passed" not in text
+    data = json.loads(to_json(partial))
+    assert data["passed"] is None and data["not_run"] == not_run.to_dict()
+    assert RunResult.from_dict(data).not_run == not_run
+    props = {p.get("name"): p.get("value")
+             for p in ET.fromstring(to_junit(partial).encode()).find("testsuite/properties")}
+    assert "passed" not in props and props["complete"] == "false"
+    page = to_html(partial)
+    verdict = re.search(r'id="verdict">(.*?)</div>\s*<p class="pass-mark">(.*?)</p>', page, re.S)
+    assert verdict is not None and "Public tests: 2.5/7" in verdict[1] and says in verdict[2]
+    assert "passed" not in verdict[0]
+
+
+def test_junit_marks_a_cut_first_line():
+    test = TestResult("test_dies", "It lives on", Fraction(0), Fraction(1), "failed",
+                      message="It ended (exit status 1). Its last lines:\nValueError: x")
+    one = RunResult("exercise", "x", "X", (test,))
+    failure = ET.fromstring(to_junit(one).encode()).find("testsuite/testcase/failure")
+    assert failure.get("message") == "It ended (exit status 1). Its last lines: …"
+    assert "ValueError: x" in failure.text
 
 
 def test_terminal_says_when_the_grader_failed():

@@ -32,6 +32,14 @@ def grade_tests(pytester: pytest.Pytester, public: str, hidden: str = "",
                 *args: str) -> dict[str, dict[str, Any]]:
     """Run the given public (and hidden) test code as an exercise's tests; the report's
     entry of each test, by name."""
+    return {entry["name"]: entry
+            for entry in run_report(pytester, public, hidden, *args)["tests"]}
+
+
+def run_report(pytester: pytest.Pytester, public: str, hidden: str = "", *args: str,
+               count_hidden: bool = False) -> dict[str, Any]:
+    """The whole signed report of such a run (``count_hidden``: as ``check`` runs, the
+    hidden tests only counted)."""
     folder = pytester.path / "mini"
     (folder / "tests" / "public").mkdir(parents=True)
     (folder / "exercise.yaml").write_text(EXERCISE_YAML)
@@ -42,14 +50,15 @@ def grade_tests(pytester: pytest.Pytester, public: str, hidden: str = "",
         (folder / "tests" / "hidden" / "test_hidden.py").write_text(textwrap.dedent(hidden))
         folders.append(folder / "tests" / "hidden")
     report = pytester.path / "report.json"
-    settings = RunSettings(exercise=str(folder), report=str(report))
+    settings = RunSettings(exercise=str(folder), report=str(report), count_only=(
+        (str(folder / "tests" / "hidden"),) if count_hidden else ()))
     pytester.runpytest("-p", "no:cacheprovider", "--autograder-settings", settings.to_json(),
                        *args, *map(str, folders))
     # No key was given: the report is signed with the empty key, and only with it.
     text = report.read_text()
     with pytest.raises(Forged):
         verify(text, b"another key")
-    return {entry["name"]: entry for entry in verify(text, b"")["tests"]}
+    return verify(text, b"")
 
 
 def test_a_pass_is_passed_with_its_label_and_one_point(pytester: pytest.Pytester) -> None:
@@ -249,6 +258,27 @@ def test_points_and_visibility_come_from_markers_and_folders(
         "hidden", "status")
     assert (tests["test_open_secret"]["visibility"],
             tests["test_open_secret"]["reveal"]) == ("visible", "message")
+
+
+def test_a_public_run_counts_the_hidden_tests_without_running_them(
+        pytester: pytest.Pytester) -> None:
+    """What ``check`` says the grade adds: the hidden tests, counted with their points."""
+    report = run_report(pytester, '''
+        def test_public():
+            pass
+    ''', '''
+        import pytest
+
+        @pytest.mark.points(3)
+        def test_secret():
+            raise AssertionError("never run")
+
+        def test_other_secret():
+            raise AssertionError("never run")
+    ''', count_hidden=True)
+    assert [entry["name"] for entry in report["tests"]] == ["test_public"]
+    assert report["tests"][0]["status"] == "passed"
+    assert report["data"]["not_run"] == {"tests": 2, "points": "4"}
 
 
 def test_a_test_that_never_ran_is_an_error_saying_so(pytester: pytest.Pytester) -> None:

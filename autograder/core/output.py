@@ -15,7 +15,7 @@ from __future__ import annotations
 import hashlib
 from pathlib import Path
 
-from autograder.i18n import _
+from autograder.i18n import _, ngettext
 
 # A test message's share of the output: the end, where the traceback is.
 TAIL_LINES = 15
@@ -69,8 +69,10 @@ def size_note(total: int, budget: int) -> str:
     """Says how much a program wrote when that was more than the sandbox kept."""
     if total <= budget:
         return ""
-    return _("(Your program wrote {size} bytes of output; only the first and last {kept} "
-             "bytes were kept.)").format(size=total, kept=budget // 2)
+    return ngettext("(Your program wrote {size} byte of output; only the first and last "
+                    "{kept} bytes were kept.)",
+                    "(Your program wrote {size} bytes of output; only the first and last "
+                    "{kept} bytes were kept.)", total).format(size=total, kept=budget // 2)
 
 
 def clip_middle(text: str, max_bytes: int) -> str:

@@ -11,6 +11,8 @@ from decimal import Decimal
 from fractions import Fraction
 from typing import Any, Literal
 
+from autograder.i18n import _, ngettext
+
 Status = Literal["passed", "failed", "error", "skipped"]
 Visibility = Literal["visible", "hidden", "after_published"]
 Kind = Literal["exercise", "quiz"]
@@ -71,6 +73,41 @@ class TestResult:
 
 
 @dataclasses.dataclass(frozen=True)
+class NotRun:
+    """What a partial run (``check``: the public tests) left for the grade: how many tests
+    and how many points, each None when not known (a student's copy has no hidden tests)."""
+
+    tests: int | None = None
+    points: Fraction | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"tests": self.tests,
+                "points": None if self.points is None else number(self.points)}
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> NotRun:
+        points = data.get("points")
+        return cls(tests=data.get("tests"), points=None if points is None else exact(points))
+
+    def describe(self) -> str:
+        """What the grade runs beyond the partial run, as far as it is known, in the active
+        language ("The grade also runs 7 hidden tests (12 points).")."""
+        points = None
+        if self.points is not None:
+            # ngettext takes a whole count: a fractional number of points reads as plural.
+            count = self.points.numerator if self.points.denominator == 1 else 2
+            points = ngettext("{points} point", "{points} points", count).format(
+                points=number(self.points))
+        if self.tests is not None and points is not None:
+            return ngettext("The grade also runs {count} hidden test ({points}).",
+                            "The grade also runs {count} hidden tests ({points}).",
+                            self.tests).format(count=self.tests, points=points)
+        if points is not None:
+            return _("The grade also runs hidden tests ({points}).").format(points=points)
+        return _("The grade also runs hidden tests.")
+
+
+@dataclasses.dataclass(frozen=True)
 class RunResult:
     """A whole grading run: what every renderer is a pure function of."""
 
@@ -88,6 +125,14 @@ class RunResult:
     # Every student program's output as the sandbox kept it (up to its output budget
     # each): for the HTML report and the log file beside the results, never in the JSON.
     log: str = ""
+    # Set for a partial run (``check``): what the grade runs beyond it. A partial run
+    # proves nothing about passing, so it never says passed.
+    not_run: NotRun | None = None
+
+    @property
+    def complete(self) -> bool:
+        """Every test of the exercise ran: the score is the grade."""
+        return self.not_run is None
 
     @property
     def score(self) -> Fraction:
@@ -103,8 +148,9 @@ class RunResult:
 
     @property
     def passed(self) -> bool:
-        """At or above the pass mark, compared exactly; never when the grader failed."""
-        return self.grader_error is None and self.max_score > 0 and \
+        """At or above the pass mark, compared exactly; never when the grader failed, nor
+        for a partial run (see :attr:`complete`)."""
+        return self.complete and self.grader_error is None and self.max_score > 0 and \
             self.fraction >= self.pass_mark
 
     @classmethod
@@ -121,7 +167,8 @@ class RunResult:
         return cls(kind=kind, id=data[kind], title=data.get("title", ""), tests=tests,
                    pass_mark=exact(data.get("pass_mark", "0.7")), lang=data.get("lang", "en"),
                    grader_error=data.get("grader_error"),
-                   execution_time=data.get("execution_time", 0.0))
+                   execution_time=data.get("execution_time", 0.0),
+                   not_run=NotRun.from_dict(data["not_run"]) if data.get("not_run") else None)
 
     def to_dict(self) -> dict[str, Any]:
         """Our JSON results shape (``--results``)."""
@@ -130,7 +177,9 @@ class RunResult:
             "title": self.title,
             "score": number(self.score),
             "max_score": number(self.max_score),
-            "passed": self.passed,
+            # A partial run (check) has no verdict: null, and what the grade adds.
+            "passed": self.passed if self.complete else None,
+            **({"not_run": self.not_run.to_dict()} if self.not_run is not None else {}),
             "pass_mark": number(self.pass_mark),
             "lang": self.lang,
             "grader_error": self.grader_error,

@@ -29,6 +29,12 @@ class RunSettings:
     isolation: Literal["strict", "basic"] = "basic"  # as the grader chose it
     lang: str = "en"
     record: str | None = None  # a folder: each test module's graph recorded as a bag in it
+    # The student's file as they named it (``mywork/avoider.py``): tracebacks and messages
+    # show it instead of the throwaway copy the program runs from. None: the file's name.
+    submission_name: str | None = None
+    # Folders whose tests are collected and counted but not run (``check``: the hidden
+    # tests), so a partial run can say what the grade adds.
+    count_only: tuple[str, ...] = ()
 
     @property
     def strict(self) -> bool:

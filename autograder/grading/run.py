@@ -24,7 +24,7 @@ from typing import Any
 from autograder.core import report
 from autograder.core.exercise import Exercise
 from autograder.core.report import RawReport, RawTest
-from autograder.core.results import RunResult, TestResult, exact
+from autograder.core.results import NotRun, RunResult, TestResult, exact
 from autograder.core.settings import RunSettings
 from autograder.i18n import _, get_language
 from autograder.sandbox.domains import DomainLock, NoDomain, hold_domain
@@ -34,17 +34,22 @@ from autograder.sandbox.process import reap_recorded
 GRADER_FAULT = "the autograder failed, tell your instructor"
 
 
+Progress = Callable[[RawTest], None]
+
+
 def grade(exercise: Exercise, submission: Path | None, *, hidden: bool = True,
           domain: int | None = None, real_time_factor: float | None = None,
-          progress: Callable[[dict[str, Any]], None] | None = None,
+          progress: Progress | None = None,
+          running: Callable[[RawTest | None], None] | None = None,
           record: Path | None = None) -> RunResult:
     """Run the exercise's public (and, with ``hidden``, hidden) tests on ``submission``.
 
     ``submission`` is the student's file or a folder holding it; None grades the reference
     solution.  Always returns a result: a broken submission scores what it showed, a fault
-    of ours sets ``grader_error``.  With ``record``, each test module's graph is recorded
-    as a rosbag2 bag in that folder (``data["bags"]``); a recording that fails is only a
-    warning (``data["warnings"]``).
+    of ours sets ``grader_error``.  ``progress`` gets each test as it finishes;
+    ``running``, a few times a second, the test that runs now (None between tests).
+    With ``record``, each test module's graph is recorded as a rosbag2 bag in that folder
+    (``data["bags"]``); a recording that fails is only a warning (``data["warnings"]``).
     """
     started = time.monotonic()
     isolation = detect()
@@ -52,7 +57,8 @@ def grade(exercise: Exercise, submission: Path | None, *, hidden: bool = True,
     try:
         with hold_domain(domain) as lock:
             result, raw = _run(exercise, submission, hidden, lock, isolation,
-                                  real_time_factor, progress, started, record)
+                               real_time_factor, _Watchers(progress, running), started,
+                               record)
     except NoDomain as exc:
         return _fault(exercise, str(exc), time.monotonic() - started)
     if warnings:
@@ -80,9 +86,29 @@ def _record_folder(record: Path | None) -> tuple[Path | None, list[str]]:
     return record, []
 
 
+@dataclasses.dataclass(frozen=True)
+class _Watchers:
+    """Who is told how the run goes (see :func:`grade`)."""
+
+    progress: Progress | None = None
+    running: Callable[[RawTest | None], None] | None = None
+
+
+def _shown_name(exercise: Exercise, submission: Path | None) -> str:
+    """The student's file as they named it, for messages: the path they gave (or the file
+    in the folder they gave), else the exercise's file name."""
+    from autograder.core.submission import SubmissionNotFound, locate
+
+    if submission is None:
+        return exercise.file
+    try:
+        return str(locate(Path(submission), exercise.file))
+    except SubmissionNotFound:
+        return exercise.file
+
+
 def _run(exercise: Exercise, submission: Path | None, hidden: bool, lock: DomainLock,
-         isolation: Isolation, real_time_factor: float | None,
-         progress: Callable[[RawTest], None] | None,
+         isolation: Isolation, real_time_factor: float | None, watchers: _Watchers,
          started: float, record: Path | None = None) -> tuple[RunResult, RawReport]:
     """One grading in a child pytest on the reserved domain; the result and raw report.
 
@@ -91,8 +117,10 @@ def _run(exercise: Exercise, submission: Path | None, hidden: bool, lock: Domain
     of a *lifeline* pipe whose write end only this process holds: when this process dies,
     however it dies, the child sees the pipe close and ends itself and every student
     process it started (see ``autograder.plugin``)."""
-    folders = [exercise.public_tests] + ([exercise.hidden_tests] if hidden else [])
-    folders = [f for f in folders if f.is_dir()]
+    # A public run collects the hidden tests too, only to count them (see the reporter).
+    folders = [f for f in (exercise.public_tests, exercise.hidden_tests) if f.is_dir()]
+    count_only = () if hidden else tuple(str(f) for f in folders
+                                         if f == exercise.hidden_tests)
     with tempfile.TemporaryDirectory(prefix="autograder-") as tmp:
         report_path = Path(tmp) / "report.json"
         key = secrets.token_bytes(32)
@@ -104,7 +132,8 @@ def _run(exercise: Exercise, submission: Path | None, hidden: bool, lock: Domain
             course=str(exercise.folder.parent.parent), report=str(report_path),
             key_fd=key_read, lifeline_fd=life_read, domain=lock.domain,
             real_time_factor=real_time_factor, isolation=isolation.mode, lang=get_language(),
-            record=str(record) if record is not None else None)
+            record=str(record) if record is not None else None,
+            submission_name=_shown_name(exercise, submission), count_only=count_only)
         command = [
             *run_prefix(isolation), sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
             "--rootdir", str(exercise.folder), "--basetemp", str(Path(tmp) / "pytest"),
@@ -122,7 +151,7 @@ def _run(exercise: Exercise, submission: Path | None, hidden: bool, lock: Domain
                 os.close(life_read)
                 with os.fdopen(key_write, "wb") as pipe:
                     pipe.write(key)
-                timed_out = _wait(child, exercise.time_limit, report_path, key, progress)
+                timed_out = _wait(child, exercise.time_limit, report_path, key, watchers)
         finally:
             os.close(life_write)
         raw = report.read(report_path, key, with_logs=True)
@@ -142,8 +171,9 @@ def _fault(exercise: Exercise, details: str, elapsed: float) -> RunResult:
 
 
 def _wait(child: subprocess.Popen[bytes], limit: float, report_path: Path, key: bytes,
-          progress: Callable[[RawTest], None] | None) -> bool:
-    """Wait for the pytest child, calling ``progress`` as tests finish; True if it ran over."""
+          watchers: _Watchers) -> bool:
+    """Wait for the pytest child, telling ``watchers`` as tests run and finish; True if it
+    ran over its time limit."""
     deadline = time.monotonic() + limit
     reported: set[str] = set()
     while True:
@@ -152,11 +182,17 @@ def _wait(child: subprocess.Popen[bytes], limit: float, report_path: Path, key: 
             finished = True
         except subprocess.TimeoutExpired:
             finished = False
-        if progress is not None:
-            for test in report.read(report_path, key).tests:
+        if watchers.progress is not None or watchers.running is not None:
+            tests = report.read(report_path, key).tests
+            for test in tests:
                 if test.done and test.nodeid not in reported:
                     reported.add(test.nodeid)
-                    progress(test)
+                    if watchers.progress is not None:
+                        watchers.progress(test)
+            if watchers.running is not None:
+                # Tests run in the order they were collected: the first not done runs now.
+                watchers.running(None if finished else
+                                 next((t for t in tests if not t.done), None))
         if finished:
             return False
         if time.monotonic() > deadline:
@@ -173,6 +209,20 @@ def _reap(child: subprocess.Popen[bytes], raw: RawReport) -> None:
         pass
     for process in raw.processes:
         reap_recorded(process)
+
+
+def result_of(raw: RawTest, status: str | None = None,
+                message: str | None = None) -> TestResult:
+    """A test of the raw report as the results model holds it (``status`` and ``message``
+    override the child's: a test the time limit stopped)."""
+    status = status or raw.status
+    max_score = exact(raw.max_score)
+    return TestResult(
+        name=raw.name, label=raw.label, score=_score(status, max_score, raw.fraction),
+        max_score=max_score, status=status,  # type: ignore[arg-type]
+        message=raw.message if message is None else message, hint=raw.hint,
+        visibility=raw.visibility, reveal=raw.reveal,  # type: ignore[arg-type]
+        details=raw.details, data={"charts": raw.charts, "nodeid": raw.nodeid})
 
 
 def _score(status: str, max_score: Fraction, fraction: float | None) -> Fraction:
@@ -205,20 +255,14 @@ def _result(exercise: Exercise, raw_report: RawReport, returncode: int | None,
     tests = []
     errors = []
     for raw in raw_report.tests:
-        status = raw.status
-        max_score = exact(raw.max_score)
-        message = raw.message
-        if timed_out and status == "error" and not raw.done:
-            status, message = "failed", _(
+        test = result_of(raw)
+        if timed_out and raw.status == "error" and not raw.done:
+            test = result_of(raw, "failed", _(
                 "Not run: grading stopped at its time limit of {seconds:.0f} s.").format(
-                seconds=exercise.time_limit)
-        if status == "error":
-            errors.append(f"{raw.name}: {message}\n{raw.details}")
-        tests.append(TestResult(
-            name=raw.name, label=raw.label,
-            score=_score(status, max_score, raw.fraction), max_score=max_score,
-            status=status, message=message, hint=raw.hint, visibility=raw.visibility,
-            reveal=raw.reveal, details=raw.details, data={"charts": raw.charts}))
+                seconds=exercise.time_limit))
+        if test.status == "error":
+            errors.append(f"{raw.name}: {test.message}\n{raw.details}")
+        tests.append(test)
     grader_error = None
     details = ""
     broken_run = returncode not in (0, 1) and not timed_out  # e.g. a test file that
@@ -235,13 +279,27 @@ def _result(exercise: Exercise, raw_report: RawReport, returncode: int | None,
                    f"tests add up to {total}")
     data = raw_report.data
     logs = data.get("logs", {})
+    not_run = None if all_tests else _not_run(exercise, data.get("not_run"), total)
     return RunResult(
         kind="exercise", id=exercise.id, title=exercise.localized_title, tests=tuple(tests),
         pass_mark=exercise.pass_fraction, lang=get_language(), grader_error=grader_error,
         grader_details=details, log_tail="\n".join(logs.values())[-4000:],
-        log=raw_report.output_log,
+        log=raw_report.output_log, not_run=not_run,
         execution_time=elapsed,
         data={"recordings": data.get("recordings", {}), "timed_out": timed_out,
               "startup_seconds": data.get("startup_seconds", []),
               "pacing": data.get("pacing", {}), "bags": data.get("bags", {}),
               "warnings": data.get("warnings", [])})
+
+
+def _not_run(exercise: Exercise, counted: dict[str, Any] | None,
+             run_points: Fraction) -> NotRun | None:
+    """What a public run left for the grade: the hidden tests the child counted, else (a
+    student's copy holds none) the points exercise.yaml says are left; None if nothing is."""
+    if counted is not None:
+        tests, points = int(counted["tests"]), exact(counted["points"])
+        return NotRun(tests, points) if tests else None
+    if exercise.points:
+        left = Fraction(exercise.points) - run_points
+        return NotRun(None, left) if left > 0 else None
+    return NotRun()

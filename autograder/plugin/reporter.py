@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import traceback
 from collections.abc import Iterator
+from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
@@ -21,8 +22,9 @@ from autograder.core.output import (
     message_tail,
 )
 from autograder.core.report import RawTest
+from autograder.core.results import exact
 from autograder.i18n import _
-from autograder.plugin.stash import credit_key, evidence_key
+from autograder.plugin.stash import credit_key, evidence_key, settings_key
 
 
 def _label(item: pytest.Item) -> str:
@@ -78,18 +80,17 @@ class GradingReporter:
         self.write()
 
     @pytest.hookimpl(trylast=True)
-    def pytest_collection_modifyitems(self, items: list[pytest.Item]) -> None:
+    def pytest_collection_modifyitems(self, config: pytest.Config,
+                                      items: list[pytest.Item]) -> None:
         if self.exercise:
             from autograder.core.exercise import find_exercise
 
             self.hidden_default = find_exercise(self.exercise).hidden_visibility
+        settings = config.stash.get(settings_key, None)
+        if settings is not None and settings.count_only:
+            items[:] = self._count_only(config, items, settings.count_only)
         for item in items:
-            from autograder.plugin import marker_problem
-
-            marker = item.get_closest_marker("points")
-            points = marker.args[0] if marker and marker.args else 1
-            if marker_problem(item) is not None:
-                points = 1  # the test errs at setup, naming the problem
+            points = _points(item)
             visibility = _visibility(item, self.hidden_default)
             self.tests[item.nodeid] = RawTest(
                 nodeid=item.nodeid, name=item.name, label=_label(item),
@@ -97,6 +98,22 @@ class GradingReporter:
                 visibility=visibility, reveal=_reveal(item, visibility),
                 message=_("Not run: the grading run ended before this test."))
         self.write()
+
+    def _count_only(self, config: pytest.Config, items: list[pytest.Item],
+                    folders: tuple[str, ...] | list[str]) -> list[pytest.Item]:
+        """``items`` less those under ``folders``, which are counted (tests and points, in
+        the report's ``not_run``) and deselected: what the grade runs beyond this run."""
+        roots = [Path(f).resolve() for f in folders]
+        kept: list[pytest.Item] = []
+        counted: list[pytest.Item] = []
+        for item in items:
+            path = Path(str(item.path)).resolve()
+            (counted if any(path.is_relative_to(r) for r in roots) else kept).append(item)
+        if counted:
+            config.hook.pytest_deselected(items=counted)
+        total = sum((exact(_points(item)) for item in counted), Fraction(0))
+        self.data["not_run"] = {"tests": len(counted), "points": str(total)}
+        return kept
 
     @pytest.hookimpl(hookwrapper=True)
     def pytest_runtest_makereport(self, item: pytest.Item,
@@ -129,6 +146,16 @@ class GradingReporter:
         if nodeid in self.tests:
             self.tests[nodeid].done = True
         self.write()
+
+
+def _points(item: pytest.Item) -> Any:
+    """The points a test is worth (its ``points`` marker, else 1)."""
+    from autograder.plugin import marker_problem
+
+    if marker_problem(item) is not None:
+        return 1  # the test errs at setup, naming the problem
+    marker = item.get_closest_marker("points")
+    return marker.args[0] if marker and marker.args else 1
 
 
 def _update(entry: RawTest, **values: Any) -> None:

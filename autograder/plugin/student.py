@@ -32,12 +32,16 @@ class StudentNode:
     """The student's running program, seen from the graph."""
 
     def __init__(self, process: StudentProcess, name: str, probe: Probe,
-                 on_stop: Callable[[StudentNode], None] | None = None) -> None:
+                 on_stop: Callable[[StudentNode], None] | None = None,
+                 shown_folder: str = "") -> None:
         self.process = process
         self.name = name
         self.probe = probe
         self.startup_seconds: float | None = None
         self.on_stop = on_stop
+        # The program runs from a throwaway folder; its tracebacks name the student's own
+        # folder instead ("" for the file's bare name), line numbers as they are.
+        self.shown_folder = shown_folder
 
     @property
     def returncode(self) -> int | None:
@@ -47,7 +51,9 @@ class StudentNode:
         return self.process.running()
 
     def output(self) -> str:
-        return self.process.output_text()
+        """What the program wrote, paths of its throwaway folder shown as the student's."""
+        return self.process.output_text().replace(f"{self.process.workdir}/",
+                                                  self.shown_folder)
 
     def output_tail(self, lines: int = TAIL_LINES, max_bytes: int = TAIL_BYTES) -> str:
         """The end of the program's output, short enough for a test message (a few lines,
@@ -111,7 +117,8 @@ def launch(request: pytest.FixtureRequest, exercise: Exercise, script: Path, pro
             process.cgroup.bounds(separate_uid=process.uid is not None or os.geteuid() != 0))
     process.start()
     world.watch_pid(process.pid)
-    node = StudentNode(process, exercise.node, probe, _log_keeper(request))
+    node = StudentNode(process, exercise.node, probe, _log_keeper(request),
+                       _shown_folder(request.config.stash[settings_key].submission_name))
     if wait_for_node:
         earlier = request.config.stash.get(startup_key, None)
         if earlier is not None:  # it already failed to appear once: do not wait again
@@ -127,6 +134,13 @@ def launch(request: pytest.FixtureRequest, exercise: Exercise, script: Path, pro
     return node
 
 
+
+
+def _shown_folder(submission_name: str | None) -> str:
+    """The prefix that stands for the program's folder in what it writes: the folder of
+    the student's file as they named it, with its slash ("" for a bare file name)."""
+    folder = os.path.dirname(submission_name or "")
+    return f"{folder}/" if folder else ""
 
 
 def _ros_value(value: Any) -> str:

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import functools
 import json
+import textwrap
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any, TypeVar
@@ -27,10 +28,17 @@ from autograder.i18n import (
 from autograder.i18n.tools import read_catalog
 from autograder.quiz import CONTENT_DOMAIN
 from autograder.quiz.catalog import find_quiz, list_quizzes, load_all
-from autograder.quiz.localize import Localizer, format_number, format_percent, terminal
+from autograder.quiz.localize import Localizer, Text, format_number, format_percent, terminal
 from autograder.quiz.model import Quiz
 from autograder.quiz.render import render_markdown, render_page, render_result
-from autograder.quiz.scoring import key_answers, pass_summary, read_answers, result_dict, score
+from autograder.quiz.scoring import (
+    key_answers,
+    pass_summary,
+    read_answers,
+    recorded_language,
+    result_dict,
+    score,
+)
 from autograder.quiz.types import question_type
 from autograder.quiz.types.base import QuestionType
 from autograder.quiz.views import QuestionView, question_views
@@ -171,14 +179,33 @@ def export_command(quizzes: tuple[str, ...], fmt: str, lang: str | None,
     click.echo(str(out))
 
 
+# Question and answer texts in a result are cut to this many characters: enough to know
+# the question again; its whole text is on the quiz's page.
+SHORT = 72
+
+
+def _short(text: str) -> str:
+    return textwrap.shorten(text, SHORT, placeholder=" …")
+
+
 def _summary(quiz: Quiz, result: RunResult) -> str:
-    """The score in the terminal: per question, then the verdict and the pass mark."""
+    """The score in the terminal: per question its text (shortened), the verdict on the
+    student's answer and the answer itself, the explanation when it was not right; then
+    the verdict and the pass mark."""
     lang = result.lang
+    loc = Localizer(quiz, lang)
     lines = [result.title, ""]
     for n, t in enumerate(result.tests, 1):
         mark = "✔" if t.status == "passed" else "✘"
-        lines.append(f" {mark} {format_number(n, lang)}. {t.message} "
+        lines.append(f" {mark} {format_number(n, lang)}. {_short(terminal(Text(t.label, lang)))} "
                      f"({format_number(t.score, lang)}/{format_number(t.max_score, lang)})")
+        answer = t.data.get("answer")
+        said = t.message
+        question = quiz.question(t.name)
+        if answer is not None and question is not None:
+            text = question_type(question.type).answer_text(quiz, question, answer, loc)
+            said += " " + _("Your answer: {answer}").format(answer=_short(text))
+        lines.append("      " + said)
         if t.status != "passed" and t.hint:
             lines.append("      " + " ".join(t.hint.split()))
     verdict = _("Passed") if result.passed else _("Not passed yet")
@@ -187,6 +214,15 @@ def _summary(quiz: Quiz, result: RunResult) -> str:
         max_score=format_number(result.max_score, lang),
         percent=format_percent(result.fraction, lang)), pass_summary(quiz, lang)]
     return for_terminal("\n".join(lines), lang)
+
+
+def _given_language(lang: str | None) -> str | None:
+    """The language asked for on the command line: this command's ``--lang``, else the
+    ``autograder --lang`` (or ``AUTOGRADER_LANG``) it runs under; None if neither."""
+    if lang:
+        return lang
+    ctx = click.get_current_context(silent=True)
+    return ctx.find_root().params.get("lang") if ctx is not None else None
 
 
 @quiz_cli.command("score")
@@ -201,9 +237,10 @@ def _summary(quiz: Quiz, result: RunResult) -> str:
 @_errors
 def score_command(quiz: str, answers: Path, lang: str | None, results: Path | None,
                   html: Path | None, as_json: bool) -> None:
-    """Score a student's ANSWERS file for QUIZ (exit 0 whatever the score)."""
-    lang = _use_lang(lang)
+    """Score a student's ANSWERS file for QUIZ (exit 0 whatever the score), in the
+    language the file was taken in unless --lang says otherwise."""
     qf = find_quiz(quiz)
+    lang = _use_lang(_given_language(lang) or recorded_language(answers, qf.quiz))
     given = read_answers(answers, qf.quiz)
     result = score(qf.quiz, given, lang)
     data = json.dumps(result_dict(result), ensure_ascii=False, indent=2)

@@ -47,6 +47,17 @@ def read_answers(path: Path | str, quiz: Quiz, text: str | None = None) -> dict[
     return check_answers(path, quiz, data, text)
 
 
+def recorded_language(path: Path | str, quiz: Quiz) -> str | None:
+    """The language an answers file says the quiz was taken in (its ``lang``), if the quiz
+    has it; None otherwise (a file that cannot be read is :func:`read_answers`' to report)."""
+    try:
+        data = json.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError):
+        return None
+    lang = data.get("lang") if isinstance(data, dict) else None
+    return lang if isinstance(lang, str) and lang in quiz.languages else None
+
+
 def check_answers(path: Path | str, quiz: Quiz, data: Any, text: str = "") -> dict[str, Any]:
     """Check the shape of decoded answers; the error names the file, line and id."""
     if not isinstance(data, dict) or not isinstance(data.get("answers"), dict):

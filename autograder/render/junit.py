@@ -19,9 +19,12 @@ def to_junit(result: RunResult) -> str:
         "time": f"{result.execution_time:.3f}",
     })
     properties = ET.SubElement(suite, "properties")
+    # A partial run (check) has no verdict: it says it is partial instead of "passed".
+    verdict = ("passed", str(result.passed).lower()) if result.complete else \
+        ("complete", "false")
     for name, value in (("score", number(result.score)), ("max_score", number(result.max_score)),
-                        ("passed", str(result.passed).lower()),
-                        ("pass_mark", number(result.pass_mark)), ("lang", result.lang)):
+                        verdict, ("pass_mark", number(result.pass_mark)),
+                        ("lang", result.lang)):
         ET.SubElement(properties, "property", {"name": name, "value": str(value)})
     for test in result.tests:
         case = ET.SubElement(suite, "testcase", {
@@ -34,8 +37,7 @@ def to_junit(result: RunResult) -> str:
         ])
         text = "\n".join(p for p in (test.message, test.hint) if p)
         if test.status == "failed":
-            ET.SubElement(case, "failure", {"message": test.message.splitlines()[0]
-                                            if test.message else ""}).text = text
+            ET.SubElement(case, "failure", {"message": _first_line(test.message)}).text = text
         elif test.status == "error":
             ET.SubElement(case, "error", {"message": test.message}).text = test.details or text
         elif test.status == "skipped":
@@ -46,6 +48,13 @@ def to_junit(result: RunResult) -> str:
         ET.SubElement(suite, "system-out").text = result.log_tail
     ET.indent(suites)
     return ET.tostring(suites, encoding="unicode", xml_declaration=True) + "\n"
+
+
+def _first_line(message: str) -> str:
+    """A message's first line for an attribute, marked when more follows (a line ending
+    "Its last lines:" must not read as if nothing came after it)."""
+    lines = message.strip().splitlines()
+    return lines[0] + (" …" if len(lines) > 1 else "") if lines else ""
 
 
 FORMAT = OutputFormat(

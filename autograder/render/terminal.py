@@ -1,4 +1,5 @@
-"""The terminal summary: a line per test with a mark, points and a one-line reason.
+"""The terminal summary: a line per test with a mark, points and label; then each failure
+once (message, the program's last lines, hint); then the score and what it proves.
 
 Also what every command printing a right-to-left language needs (:func:`for_terminal`,
 :func:`rtl_notice`): a terminal that lays out bidi text takes each line's direction from
@@ -12,12 +13,13 @@ from __future__ import annotations
 
 import re
 import unicodedata
+from collections.abc import Collection, Iterable
 from pathlib import Path
 
 from babel.numbers import format_percent
 
 from autograder.core.results import RunResult, TestResult, as_decimal, number
-from autograder.i18n import _, get_language, is_rtl
+from autograder.i18n import _, get_language, is_rtl, ngettext
 
 RLM = "\u200f"
 _ANSI = re.compile(r"\x1b\[[0-9;]*[A-Za-z]")
@@ -69,8 +71,10 @@ def rtl_notice(lang: str | None = None, html: Path | None = None,
                  "browser.")
     return for_terminal(text, lang)
 
+
 _MARKS = {"passed": ("✔", "green"), "failed": ("✘", "red"), "error": ("!", "yellow"),
           "skipped": ("-", "yellow")}
+_INDENT = "    "
 
 
 def _style(text: str, color: str | None, enabled: bool, bold: bool = False) -> str:
@@ -81,14 +85,63 @@ def _style(text: str, color: str | None, enabled: bool, bold: bool = False) -> s
     return click.style(text, fg=color, bold=bold)
 
 
-def test_line(test: TestResult, color: bool = False, reveal: bool = True) -> str:
+def heading(exercise: str, title: str, color: bool = False) -> str:
+    """The first line of a grading's output: the exercise and its title."""
+    return for_terminal(_style(f"{exercise} — {title}", None, color, bold=True))
+
+
+def test_line(test: TestResult, color: bool = False) -> str:
+    """A test in one line: its mark, its points and its label (what went wrong comes once,
+    in :func:`failure_blocks`)."""
     mark, tint = _MARKS[test.status]
     points = f"{number(test.score)}/{number(test.max_score)}"
-    line = f" {_style(mark, tint, color)} {points:>5}  {test.label}"
-    if test.status != "passed" and reveal and test.message:
-        first = test.message.strip().splitlines()[0]
-        line += "\n" + " " * 10 + _style(first, None, color)
-    return for_terminal(line)
+    return for_terminal(f" {_style(mark, tint, color)} {points:>5}  {test.label}")
+
+
+def _indented(text: str) -> list[str]:
+    return [(_INDENT + line).rstrip() for line in text.strip("\n").splitlines()]
+
+
+def failure_blocks(tests: Iterable[TestResult], color: bool = False) -> list[str]:
+    """What the failed (and skipped) tests say, each once: its label and its message (the
+    program's last lines within it), as far as the test reveals them. Failures with the
+    same hint stand together, in the order of the first, under that hint said once: one
+    cause, several symptoms."""
+    groups: dict[str, list[TestResult]] = {}
+    for test in tests:
+        message, hint = test.student_message.strip(), test.student_hint.strip()
+        if test.status in ("failed", "skipped") and (message or hint):
+            groups.setdefault(hint or f"\0{line_key(test)}", []).append(test)
+    blocks = []
+    for hint, group in groups.items():
+        lines = []
+        for test in group:
+            mark, tint = _MARKS[test.status]
+            lines += [_style(f"{mark} {test.label}", tint, color, bold=True),
+                      *_indented(test.student_message)]
+        if not hint.startswith("\0"):
+            said = _("Hint: {hint}") if len(group) == 1 else ngettext(
+                "Hint for the failure above: {hint}", "Hint for the {count} failures above: "
+                "{hint}", len(group))
+            lines += _indented(said.format(hint=hint, count=len(group)))
+        blocks.append("\n".join(lines))
+    return blocks
+
+
+def score_lines(result: RunResult, color: bool = False) -> list[str]:
+    """The score and what it proves: the verdict of a whole grading, or for a partial run
+    (``check``) the public tests' score and what the grade adds, never a verdict."""
+    score, max_score = number(result.score), number(result.max_score)
+    percent = format_percent(as_decimal(result.fraction), locale=result.lang)
+    if result.not_run is not None:
+        line = _("Public tests: {score}/{max_score} ({percent}).").format(
+            score=score, max_score=max_score, percent=percent)
+        return [_style(line, None, color, bold=True), result.not_run.describe()]
+    mark = format_percent(as_decimal(result.pass_mark), locale=result.lang)
+    verdict = _("passed") if result.passed else _("not passed")
+    line = _("Score: {score}/{max_score} ({percent}), {verdict} (pass mark {mark})").format(
+        score=score, max_score=max_score, percent=percent, verdict=verdict, mark=mark)
+    return [_style(line, "green" if result.passed else "red", color, bold=True)]
 
 
 def _bound(kind: str | None, cgroup: str | None, controller: str, rlimit: str) -> str:
@@ -113,33 +166,27 @@ def isolation_line(isolation: dict) -> str:
              "{limits}.").format(reason=_(isolation.get("reason", "")), limits=limits)
 
 
-def to_terminal(result: RunResult, color: bool = False, show_details: bool = True) -> str:
-    """The whole summary. ``show_details`` adds every failure's full message and hint."""
-    lines = [_style(f"{result.id} — {result.title}", None, color, bold=True), ""]
-    for test in result.tests:
-        reveal = test.visibility == "visible" or show_details
-        lines.append(test_line(test, color, reveal))
-    lines.append("")
-    percent = format_percent(as_decimal(result.fraction), locale=result.lang)
-    mark = format_percent(as_decimal(result.pass_mark), locale=result.lang)
-    verdict = _("passed") if result.passed else _("not passed")
-    lines.append(_style(_("Score: {score}/{max_score} ({percent}), {verdict} (pass mark {mark})")
-                        .format(score=number(result.score), max_score=number(result.max_score),
-                                percent=percent, verdict=verdict, mark=mark),
-                        "green" if result.passed else "red", color, bold=True))
+def to_terminal(result: RunResult, color: bool = False, shown: Collection[str] = (),
+                with_heading: bool = True) -> str:
+    """The whole summary: a line per test (but those in ``shown``, already printed as
+    they ran: see :mod:`autograder.render.live`), each failure once with its message and
+    hint, then the score and what it proves."""
+    lines = [heading(result.id, result.title, color), ""] if with_heading else []
+    lines += [test_line(t, color) for t in result.tests if line_key(t) not in shown]
+    for block in failure_blocks(result.tests, color):
+        lines += ["", block]
+    lines += ["", *score_lines(result, color)]
     isolation = result.data.get("isolation", {})
     if isolation:
         lines.append(isolation_line(isolation))
     if result.grader_error:
         lines.append(_style(_("The autograder failed, tell your instructor."), "yellow", color,
                             bold=True))
-        if show_details and result.grader_details:
+        if result.grader_details:
             lines.append(result.grader_details.strip()[-2000:])
-    if show_details:
-        failures = [t for t in result.tests if t.status == "failed" and
-                    (t.visibility == "visible" or show_details)]
-        for test in failures:
-            lines += ["", _style(f"✘ {test.label}", "red", color, bold=True), test.message]
-            if test.hint:
-                lines.append(_("Hint: {hint}").format(hint=test.hint))
     return for_terminal("\n".join(lines), result.lang)
+
+
+def line_key(test: TestResult) -> str:
+    """What tells a test from the others in a run (its node id when the run knows it)."""
+    return str(test.data.get("nodeid") or test.name)

@@ -13,7 +13,7 @@ from collections.abc import Mapping
 from fractions import Fraction
 from typing import TYPE_CHECKING, Any, ClassVar
 
-from autograder.i18n import _
+from autograder.i18n import _, ngettext
 from autograder.quiz.localize import Localizer, format_number, terminal
 from autograder.quiz.model import Option, Question, Quiz, check_id
 from autograder.quiz.shuffle import attempt_rng, shuffle_unpinned
@@ -127,9 +127,17 @@ class QuestionType(abc.ABC):
         if earned == points:
             return _("Correct.")
         if earned:
-            return _("Partly correct: {score} of {max} points.").format(
+            return ngettext("Partly correct: {score} of {max} point.",
+                            "Partly correct: {score} of {max} points.", q.points).format(
                 score=format_number(earned, lang), max=format_number(points, lang))
         return _("Incorrect.")
+
+    def answer_text(self, quiz: Quiz, q: Question, value: Any, loc: Localizer) -> str:
+        """A checked answer (never None) as the student reads it back in a terminal: the
+        texts of the options it names, in its order."""
+        texts = {v.id: terminal(v.text) for v in self.option_views(quiz, q, None, loc)}
+        chosen = value if isinstance(value, list) else [value]
+        return ", ".join(texts.get(str(c), str(c)) for c in chosen)
 
     # One attempt ------------------------------------------------------------------------
 

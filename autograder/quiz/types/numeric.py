@@ -6,13 +6,16 @@ Compared exactly (as fractions), so 0.3 with a tolerance of 0.05 accepts 0.35.
 from __future__ import annotations
 
 import math
+from decimal import Decimal
 from fractions import Fraction
 from typing import TYPE_CHECKING, Any
 
+from babel.numbers import format_decimal
+
 from autograder.core.results import exact
 from autograder.i18n import N_, _
-from autograder.quiz.localize import markdown_inline
-from autograder.quiz.model import Question
+from autograder.quiz.localize import Localizer, babel_locale, markdown_inline, terminal
+from autograder.quiz.model import Question, Quiz
 from autograder.quiz.types import register
 from autograder.quiz.types.base import Form, LintNote, QuestionType, Where, first_value
 from autograder.quiz.views import QuestionView
@@ -61,6 +64,12 @@ class Numeric(QuestionType):
 
     def credit(self, q: Question, value: Any) -> Fraction:
         return Fraction(abs(exact(value) - exact(q.answer)) <= exact(q.tolerance))
+
+    def answer_text(self, quiz: Quiz, q: Question, value: Any, loc: Localizer) -> str:
+        # The number as given (never rounded: 0.355 is not 0.36), then the unit.
+        number = format_decimal(Decimal(repr(value)), locale=babel_locale(loc.lang),
+                                decimal_quantization=False)
+        return f"{number} {terminal(loc.text(q, 'unit'))}" if q.unit else number
 
     def prompt(self, view: QuestionView) -> str:
         return _("Your answer (a number, Enter to skip)")

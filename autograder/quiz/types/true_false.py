@@ -50,6 +50,11 @@ class TrueFalse(SingleChoice):
         chosen = value if isinstance(value, bool) else value == "true"
         return Fraction(chosen == q.answer)
 
+    def answer_text(self, quiz: Quiz, q: Question, value: Any, loc: Localizer) -> str:
+        if isinstance(value, bool):
+            value = "true" if value else "false"
+        return super().answer_text(quiz, q, value, loc)
+
     def option_views(self, quiz: Quiz, q: Question, seed: str | int | None,
                      loc: Localizer) -> tuple[OptionView, ...]:
         # Always True then False, never shuffled: the order is part of how it reads.
