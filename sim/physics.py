@@ -233,8 +233,14 @@ class World:
 
     @property
     def geometry(self) -> tuple[np.ndarray, np.ndarray]:
-        """Everything a ray can hit: segments (N, 4) [x1 y1 x2 y2] and circles (M, 3)."""
+        """Everything a ray can hit: segments (N, 4) [x1 y1 x2 y2] and circles (M, 3).
+
+        The same read-only arrays until an obstacle is added or the world is reset, so
+        the lidar prepares them for casting once per change (:func:`sim.raycast.prepared`).
+        """
         if self._geometry is None:
-            self._geometry = (np.array(self._segments, dtype=float).reshape(-1, 4),
-                              np.array(self._circles, dtype=float).reshape(-1, 3))
+            segments = np.array(self._segments, dtype=float).reshape(-1, 4)
+            circles = np.array(self._circles, dtype=float).reshape(-1, 3)
+            segments.flags.writeable = circles.flags.writeable = False
+            self._geometry = (segments, circles)
         return self._geometry
