@@ -96,11 +96,26 @@ def test_other_lidars_match_the_reference(lidar: Lidar) -> None:
                            reference_cast(lidar, x, y, theta, segments, circles))
 
 
+def _loop(*corners: tuple[float, float]) -> np.ndarray:
+    """The closed chain of edges through ``corners``, as World lists a box's."""
+    return np.array([(*a, *b) for a, b in zip(corners, corners[1:] + corners[:1],
+                                              strict=True)], dtype=float)
+
+
+# No corner lies exactly on a beam: there the reference's rounding may miss both edges.
+SQUARE = ((0.5, -0.4), (1.5, -0.4), (1.5, 0.6), (0.5, 0.6))
+L_SHAPE = ((0.5, -1.0), (2.0, -1.0), (2.0, 0.2), (1.0, 0.2), (1.0, 1.1), (0.5, 1.1))
+NO_CIRCLES = np.zeros((0, 3))
 SHAPES = {
-    "nothing": (np.zeros((0, 4)), np.zeros((0, 3))),
-    "one segment": (np.array([[1.0, -1.0, 1.0, 1.0]]), np.zeros((0, 3))),
+    "nothing": (np.zeros((0, 4)), NO_CIRCLES),
+    "one segment": (np.array([[1.0, -0.8, 1.0, 1.2]]), NO_CIRCLES),
     "one circle": (np.zeros((0, 4)), np.array([[0.0, 2.0, 0.5]])),
     "inside a circle": (np.zeros((0, 4)), np.array([[0.1, 0.0, 1.0]])),
+    "square": (_loop(*SQUARE), NO_CIRCLES),
+    "square clockwise": (_loop(*SQUARE[::-1]), NO_CIRCLES),
+    "inside a square": (_loop((-0.5, -0.4), (0.6, -0.4), (0.6, 0.7), (-0.5, 0.7)), NO_CIRCLES),
+    "L-shaped loop": (_loop(*L_SHAPE), NO_CIRCLES),
+    "open chain": (_loop(*SQUARE)[:3], np.array([[-1.0, 0.0, 0.3]])),
 }
 
 
@@ -110,6 +125,34 @@ def test_few_shapes_match_the_reference(shapes: tuple[np.ndarray, np.ndarray]) -
     for theta in (0.0, 0.3, -2.0):
         assert_same_ranges(lidar.cast(0.0, 0.0, theta, *shapes),
                            reference_cast(lidar, 0.0, 0.0, theta, *shapes))
+
+
+def test_only_closed_convex_loops_have_sides() -> None:
+    """Edges facing away are left out only where that cannot change a range."""
+    assert list(raycast.prepare(_loop(*SQUARE), NO_CIRCLES).sides) == [1.0] * 4
+    assert list(raycast.prepare(_loop(*SQUARE[::-1]), NO_CIRCLES).sides) == [-1.0] * 4
+    assert raycast.prepare(_loop(*L_SHAPE), NO_CIRCLES).sides is None
+    assert raycast.prepare(_loop(*SQUARE)[:3], NO_CIRCLES).sides is None
+    world = World(load_world("obstacles"))  # four thick walls and three boxes
+    assert list(raycast.prepared(*world.geometry).groups) == [0, 4, 8, 12, 16, 20, 24]
+
+
+@pytest.mark.parametrize("corners", [SQUARE, SQUARE[::-1]], ids=["ccw", "cw"])
+def test_a_beam_through_a_corner_hits_it(corners) -> None:
+    """Corners at exactly 45 degrees: the edge facing the beam is hit at its very end."""
+    square = _loop(*((x, y - 0.1) for x, y in corners))  # (0.5, +-0.5) and beyond
+    ranges = Lidar().cast(0.0, 0.0, 0.0, square, NO_CIRCLES)
+    assert ranges[45] == pytest.approx(math.sqrt(0.5), abs=1e-9)
+    assert ranges[315] == pytest.approx(math.sqrt(0.5), abs=1e-9)
+
+
+def test_inside_a_box_the_robot_sees_its_walls() -> None:
+    world = World(load_world("empty_room"))
+    world.add_obstacle(Box(center=(3.2, 3.0), size=(1.0, 0.6)))
+    ranges = Lidar().scan(world)
+    assert ranges[0] == pytest.approx(0.7, abs=1e-9)
+    assert ranges[90] == pytest.approx(0.3, abs=1e-9)
+    assert ranges[180] == pytest.approx(0.3, abs=1e-9)
 
 
 def test_world_geometry_is_prepared_once_per_change() -> None:
