@@ -220,8 +220,8 @@ class World:
     def pose(self) -> tuple[float, float, float]:
         """(x, y, theta) of the robot in the world frame, theta wrapped to (-pi, pi]."""
         x, y = self.robot.position
-        theta = math.atan2(math.sin(self.robot.angle), math.cos(self.robot.angle))
-        return float(x), float(y), theta
+        angle = self.robot.angle
+        return float(x), float(y), math.atan2(math.sin(angle), math.cos(angle))
 
     @property
     def velocity(self) -> tuple[float, float]:
