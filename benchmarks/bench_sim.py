@@ -2,9 +2,10 @@
 with the ROS bridge publishing as fast as it can (RTF 0, no watched process).
 
 Measured on a 2-core AMD EPYC shared with other work (2026-11, Python 3.11, pymunk 7.3,
-NumPy 2.4): physics + lidar about 900x real time (median of 5 runs; 860 to 980 over
-processes), a scan about 25 us.  ``benchmarks/bench_peers.py`` runs the same loop beside
-MuJoCo, PyBullet and ir-sim.
+NumPy 2.4): physics + lidar 917x real time (median of 5 runs, 877 to 953 over runs), a
+scan 25 us; before the ray cast was rewritten, 339x and 110 us in the same hour.  With
+the ROS bridge, 36x (the clock cap bounds it).  ``benchmarks/bench_peers.py`` runs the
+same loop beside MuJoCo, PyBullet and ir-sim.
 
 Run: ``python benchmarks/bench_sim.py [--sim-seconds 60] [--runs 5] [--domain 99]``.
 """
