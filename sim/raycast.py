@@ -144,9 +144,10 @@ def prepared(segments: np.ndarray, circles: np.ndarray) -> Targets:
     hit = _cache.get(key)
     if hit is not None and hit[0]() is segments and hit[1]() is circles:
         return hit[2]
-    if len(_cache) >= 32:
-        for old in [k for k, (s, c, _t) in _cache.items() if s() is None or c() is None]:
-            del _cache[old]
+    if len(_cache) >= 32:  # forget geometry that is gone (the bridge's thread may scan too)
+        for old, (s, c, _t) in list(_cache.items()):
+            if s() is None or c() is None:
+                _cache.pop(old, None)
         if len(_cache) >= 32:
             _cache.clear()
     targets = prepare(segments, circles)

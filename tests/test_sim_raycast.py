@@ -174,3 +174,11 @@ def test_arrays_the_caller_may_change_are_read_afresh() -> None:
     assert lidar.cast(0.0, 0.0, 0.0, segments, circles)[0] == pytest.approx(1.0)
     segments[:, [0, 2]] = 2.0
     assert lidar.cast(0.0, 0.0, 0.0, segments, circles)[0] == pytest.approx(2.0)
+
+
+def test_many_worlds_do_not_pile_up_prepared_geometry() -> None:
+    worlds = [World(load_world("empty_room")) for _ in range(40)]
+    for world in worlds:
+        world.add_obstacle(Circle(center=(3.0, 4.0), radius=0.5))
+        assert Lidar().scan(world)[90] == pytest.approx(0.5, abs=1e-9)
+    assert len(raycast._cache) <= 32
