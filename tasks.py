@@ -43,7 +43,8 @@ JOBS = {
     # where the suite's minutes go, in every CI log.
     "test-all": [["python", "-m", "pytest", "--durations=10"]],
     "lint": [["ruff", "check", "."]],
-    "bench": [["python", "benchmarks/bench_grading.py"], ["python", "benchmarks/bench_sim.py"]],
+    "bench": [["python", "benchmarks/bench_grading.py"], ["python", "benchmarks/bench_sim.py"],
+              ["python", "benchmarks/bench_peers.py"]],
 }
 
 

@@ -28,6 +28,9 @@ class Outputs:
     scan_due: bool = False
 
 
+_NOTHING = Outputs()
+
+
 class Simulation:
     """A :class:`World` plus its sensors, faults and recording."""
 
@@ -47,9 +50,12 @@ class Simulation:
         world.step()
         for contact in world.drain_contacts():
             self.recording.add_collision(contact)
+        steps = world.steps
+        odom_due, scan_due = steps % self._odom_every == 0, steps % self._scan_every == 0
+        if not (odom_due or scan_due):
+            return _NOTHING  # most steps: the bridge runs this 200 times a simulated second
         odom = scan = None
-        scan_due = world.steps % self._scan_every == 0
-        if world.steps % self._odom_every == 0:
+        if odom_due:
             odom = Sample(world.time, *world.pose, *world.velocity)
             self.recording.add_sample(odom)
         if scan_due:
