@@ -5,6 +5,7 @@ A thin click layer: each command calls plain functions of the ``sim`` package.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import os
@@ -70,9 +71,12 @@ def check_command(file: Path) -> None:
               show_default=True,
               help="Most /clock messages per wall second (as graded: Jazzy's "
                    "MultiThreadedExecutor stutters from about 50 Hz).")
+@click.option("--cmd-vel-type", type=click.Choice(["Twist", "TwistStamped"]), default=None,
+              help="Message type the robot takes on /cmd_vel (default: the world's, "
+                   "usually Twist; Jazzy's TurtleBot3 takes TwistStamped).")
 def run_command(world_name: str, rtf: float, duration: float | None, domain: int | None,
                 record: Path | None, svg: Path | None, seed: int | None,
-                clock_hz: float) -> None:
+                clock_hz: float, cmd_vel_type: str | None) -> None:
     """Run a world on a ROS domain so a node started by hand can drive the robot.
 
     Start your node in another terminal with the same ROS_DOMAIN_ID and
@@ -80,6 +84,8 @@ def run_command(world_name: str, rtf: float, duration: float | None, domain: int
     """
     spec = _load(world_name)
     domain = int(os.environ.get("ROS_DOMAIN_ID", "0")) if domain is None else domain
+    if cmd_vel_type is not None:
+        spec = dataclasses.replace(spec, cmd_vel_type=cmd_vel_type)
     summary = run_world(spec, rtf=rtf, duration=duration, domain=domain, seed=seed,
                         record=record, svg=svg, clock_hz=clock_hz)
     click.echo(summary)
@@ -102,9 +108,11 @@ def run_world(spec, *, rtf: float, duration: float | None, domain: int,  # noqa:
     click.echo(_("World {name} on ROS domain {domain}, RTF {rtf}. Ctrl-C stops.").format(
         name=spec.name, domain=domain, rtf=rtf or _("max")))
     bridge.start()
+    warned: set[object] = set()
     try:
         while duration is None or bridge.now < duration:
             bridge.wait_until(duration if duration is not None else math.inf, 0.5)
+            _warn_mismatches(bridge, warned)
     except KeyboardInterrupt:
         pass
     finally:
@@ -119,13 +127,26 @@ def run_world(spec, *, rtf: float, duration: float | None, domain: int,  # noqa:
     return _summary(spec, bridge, effective)
 
 
+def _warn_mismatches(bridge, warned: set[object]) -> None:  # noqa: ANN001
+    """Say once of each publisher on /cmd_vel whose type the robot does not take."""
+    from sim.cmdvel import world_warning
+
+    for mismatch in bridge.cmd_vel_mismatches():
+        if mismatch not in warned:
+            warned.add(mismatch)
+            click.echo(world_warning(mismatch), err=True)
+
+
 def _summary(spec, bridge, effective: float) -> str:  # noqa: ANN001
     samples, collisions = bridge.recording.snapshot()
     x, y, theta = bridge.world.pose
+    ox, oy, otheta = bridge.sim.odometry.pose
     lines = [
         _("Sim time: {t:.2f} s (measured RTF {rtf:.2f})").format(t=bridge.now, rtf=effective),
         _("Final pose: x={x:.3f} m, y={y:.3f} m, theta={theta:.3f} rad").format(
             x=x, y=y, theta=theta),
+        _("Odometry (odom frame, from the wheels): x={x:.3f} m, y={y:.3f} m, "
+          "theta={theta:.3f} rad").format(x=ox, y=oy, theta=otheta),
         _("Distance travelled: {d:.2f} m").format(d=bridge.recording.distance()),
         _("Collisions: {n}").format(n=len(collisions)),
     ]
