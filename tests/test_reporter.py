@@ -162,6 +162,46 @@ def test_partial_credit_is_a_failure_with_its_fraction(pytester: pytest.Pytester
     assert entry["fraction"] is None
 
 
+def test_a_type_mismatch_leads_every_failure_once(pytester: pytest.Pytester) -> None:
+    """What the graph showed of types that never match (plugin/msgtypes.py) comes first in
+    each failed test's message, once; a pass or our own error does not get it."""
+    tests = grade_tests(pytester, '''
+        import pytest
+        from autograder.core.errors import StudentFailure
+        from autograder.plugin.stash import type_note_key
+
+        NOTE = "Your node publishes A on /cmd_vel, but this robot takes B."
+
+        @pytest.fixture(autouse=True)
+        def mismatch(request):
+            yield
+            request.node.stash[type_note_key] = NOTE
+
+        def test_nothing_came():
+            raise StudentFailure("nothing on cmd_vel", "publish it")
+
+        def test_part_of_the_way(credit):
+            credit.award(0.5, "half")
+
+        def test_passes():
+            pass
+
+        def test_our_bug():
+            raise RuntimeError("ours")
+
+        def test_says_it_already():
+            raise StudentFailure(NOTE)
+    ''')
+    note = "Your node publishes A on /cmd_vel, but this robot takes B."
+    assert tests["test_nothing_came"]["message"] == f"{note}\n\nnothing on cmd_vel"
+    assert tests["test_nothing_came"]["hint"] == "publish it"
+    assert tests["test_part_of_the_way"]["message"] == f"{note}\n\nhalf"
+    assert tests["test_part_of_the_way"]["fraction"] == 0.5
+    assert tests["test_passes"]["message"] == ""
+    assert tests["test_our_bug"]["message"] == "RuntimeError: ours"
+    assert tests["test_says_it_already"]["message"] == note
+
+
 def test_a_teardown_failure_after_a_pass_is_classified(pytester: pytest.Pytester) -> None:
     """As the graph guard does: a fixture that finds tampering after the test fails it."""
     tests = grade_tests(pytester, '''

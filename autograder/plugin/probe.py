@@ -22,6 +22,8 @@ from rclpy.qos import QoSProfile, ReliabilityPolicy
 
 from autograder.core.errors import GraderError, StudentFailure
 from autograder.i18n import _
+from autograder.plugin.msgtypes import CHECK_EVERY, TypeWatch, watch_world_cmd_vel
+from sim.cmdvel import type_name
 
 M = TypeVar("M")
 
@@ -121,9 +123,13 @@ class Probe:
                          parameter_overrides=[Parameter("use_sim_time", value=True)])
         self._executor = SingleThreadedExecutor(context=context)
         self._executor.add_node(self.node)
+        self._publishers: dict[str, Any] = {}
+        # Endpoints of the student's whose type never matches the grader's (msgtypes.py).
+        self.types = TypeWatch(self.node, GRADER_NODES)
+        watch_world_cmd_vel(self.types, getattr(world, "cmd_vel_type", None))
+        self.node.create_timer(CHECK_EVERY, self.types.check)  # in simulation time
         self._thread = threading.Thread(target=self._spin, daemon=True, name="probe-executor")
         self._thread.start()
-        self._publishers: dict[str, Any] = {}
 
     def _spin(self) -> None:
         try:
@@ -198,21 +204,24 @@ class Probe:
         else:
             inbox.subscription = self.node.create_subscription(
                 msg_type, topic, lambda m: inbox.add(self.now, m), qos)
+        self.types.takes(inbox.subscription.topic_name, type_name(msg_type))
         return inbox
 
     def publish(self, msg_type: type, topic: str, message: Any) -> None:
+        self._publisher(msg_type, topic).publish(message)
+
+    def wait_for_subscriber(self, msg_type: type, topic: str, sim_timeout: float = 5.0) -> bool:
+        """Wait until someone subscribes to ``topic`` (so our first message is not lost)."""
+        publisher = self._publisher(msg_type, topic)
+        return self.wait_for(lambda: publisher.get_subscription_count() > 0, sim_timeout)
+
+    def _publisher(self, msg_type: type, topic: str) -> Any:
         publisher = self._publishers.get(topic)
         if publisher is None:
             publisher = self.node.create_publisher(msg_type, topic, 10)
             self._publishers[topic] = publisher
-        publisher.publish(message)
-
-    def wait_for_subscriber(self, msg_type: type, topic: str, sim_timeout: float = 5.0) -> bool:
-        """Wait until someone subscribes to ``topic`` (so our first message is not lost)."""
-        if topic not in self._publishers:
-            self._publishers[topic] = self.node.create_publisher(msg_type, topic, 10)
-        publisher = self._publishers[topic]
-        return self.wait_for(lambda: publisher.get_subscription_count() > 0, sim_timeout)
+            self.types.sends(publisher.topic_name, type_name(msg_type))
+        return publisher
 
     # -- graph -------------------------------------------------------------------------
     def node_names(self) -> set[str]:

@@ -22,7 +22,7 @@ from autograder.core.output import (
 )
 from autograder.core.report import RawTest
 from autograder.i18n import _
-from autograder.plugin.stash import credit_key, evidence_key
+from autograder.plugin.stash import credit_key, evidence_key, type_note_key
 
 
 def _label(item: pytest.Item) -> str:
@@ -123,6 +123,8 @@ class GradingReporter:
                 _update(entry, **_classify(call.excinfo))
         elif call.when == "teardown" and outcome_report.failed and entry.status == "passed":
             _update(entry, **_classify(call.excinfo))
+        if call.when == "teardown":
+            _lead_with(entry, item.stash.get(type_note_key, ""))
         _bound(entry)
 
     def pytest_runtest_logfinish(self, nodeid: str) -> None:
@@ -134,6 +136,13 @@ class GradingReporter:
 def _update(entry: RawTest, **values: Any) -> None:
     for key, value in values.items():
         setattr(entry, key, value)
+
+
+def _lead_with(entry: RawTest, note: str) -> None:
+    """Put ``note`` (why messages never matched, say) once before a failed test's message:
+    it is what the student must fix first."""
+    if note and entry.status == "failed" and note not in entry.message:
+        entry.message = f"{note}\n\n{entry.message}" if entry.message else note
 
 
 def _bound(entry: RawTest) -> None:

@@ -93,7 +93,8 @@ def world(request: pytest.FixtureRequest, exercise: Exercise,
     bridge = SimBridge(World(spec), ros_context, node_name=WORLD_NODE_NAME,
                        max_clock_hz=exercise.clock_hz,
                        cpu_budget=exercise.cpu_budget,
-                       real_time_factor=exercise.real_time_factor if rtf is None else rtf)
+                       real_time_factor=exercise.real_time_factor if rtf is None else rtf,
+                       cmd_vel_type=exercise.cmd_vel_type)
     bridge.start()
     try:
         yield bridge
