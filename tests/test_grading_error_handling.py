@@ -12,7 +12,7 @@ from __future__ import annotations
 import re
 
 import pytest
-from proving import Proof
+from proving import Proof, without_both_types
 
 pytestmark = pytest.mark.slow
 
@@ -38,3 +38,9 @@ def test_shutdown_failure_shows_the_traceback(graded):
     message = by_name["test_clean_exit_on_sigint"].message
     assert re.search(r"After SIGINT \(trial [123] of 3\)", message), message
     assert "Traceback" in message
+
+
+def test_a_twist_stamped_node_is_told_both_types(graded):
+    """The reference solution publishing TwistStamped, as for Jazzy's TurtleBot3: every test
+    it loses says what it sent and what this exercise's robot takes."""
+    assert without_both_types(graded["twist_stamped"]) == {}

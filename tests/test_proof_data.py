@@ -20,6 +20,7 @@ from proving import (
     load_variant,
     load_variants,
     make_patch,
+    without_both_types,
 )
 
 from autograder.core.exercise import find_exercise
@@ -143,3 +144,22 @@ def test_no_newline_at_end_of_file() -> None:
 def test_a_malformed_patch_is_refused(patch: str, problem: str) -> None:
     with pytest.raises(PatchError, match=problem):
         apply_patch("a\n", patch)
+
+
+def test_both_velocity_types_must_be_named_in_every_lost_test() -> None:
+    from fractions import Fraction
+
+    from autograder.core.results import RunResult, TestResult
+
+    def result(*messages: str) -> RunResult:
+        return RunResult("exercise", "x", "X", tuple(
+            TestResult(f"test_{i}", "", Fraction(0), Fraction(1), "failed", message)
+            for i, message in enumerate(messages)) + (
+            TestResult("test_ok", "", Fraction(1), Fraction(1), "passed"),))
+
+    both = ("publishes geometry_msgs/msg/TwistStamped on /cmd_vel, but this robot takes "
+            "geometry_msgs/msg/Twist (its cmd_vel_type)")
+    assert without_both_types(result(both, both)) == {}
+    stamped_only = "publishes geometry_msgs/msg/TwistStamped on /cmd_vel"
+    assert without_both_types(result(both, stamped_only, "nothing on cmd_vel")) == {
+        "test_1": stamped_only, "test_2": "nothing on cmd_vel"}

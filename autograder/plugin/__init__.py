@@ -33,15 +33,14 @@ from autograder.core.settings import RunSettings
 from autograder.i18n import set_language
 from autograder.plugin.credit import credit, evidence
 from autograder.plugin.guard import _graph_guard
-from autograder.plugin.msgtypes import _message_types
 from autograder.plugin.reporter import GradingReporter
 from autograder.plugin.stash import reporter_key, settings_key
 from autograder.plugin.student import start_node, student
 from autograder.plugin.world import exercise, probe, ros_context, submission_file, world
 
 # The fixtures, here so that pytest finds them in the plugin it loaded.
-__all__ = ["GradingReporter", "_graph_guard", "_message_types", "credit", "evidence",
-           "exercise", "probe", "ros_context", "start_node", "student", "submission_file", "world"]
+__all__ = ["GradingReporter", "_graph_guard", "credit", "evidence", "exercise", "probe",
+           "ros_context", "start_node", "student", "submission_file", "world"]
 
 MARKERS = {
     "points": "points(n): points the test is worth, a positive number (default 1)",

@@ -2,20 +2,20 @@
 than the grader's on the same topic (``TwistStamped`` where the robot takes ``Twist``).
 
 DDS never connects such endpoints and nothing says so: the node would just lose points
-for "nothing on cmd_vel".  The probe watches the graph (:class:`TypeWatch`) and every
-failing test's feedback names both types and the fix, once.
+for "nothing on cmd_vel".  The probe watches the graph (:class:`TypeWatch`, every
+``CHECK_EVERY`` of sim time and at each test's end) and the reporter puts what it saw, once,
+before the message of every test that failed, setup failures of module fixtures included.
 """
 
 from __future__ import annotations
 
 import threading
-from collections.abc import Iterator
 from typing import TYPE_CHECKING
 
 import pytest
 
 from autograder.i18n import _
-from autograder.plugin.stash import settings_key, type_note_key
+from autograder.plugin.stash import type_watch_key
 from sim.cmdvel import CMD_VEL_TOPIC, Mismatch, full_name, mismatches, short
 
 if TYPE_CHECKING:
@@ -36,6 +36,7 @@ class TypeWatch:
         self.published: dict[str, str] = {}   # topic -> full type the grader sends there
         self._seen: set[Mismatch] = set()
         self._lock = threading.Lock()
+        self.closed = False
 
     def takes(self, topic: str, type_name: str) -> None:
         """The grader subscribes to ``topic`` with ``type_name`` (the world's own first)."""
@@ -50,11 +51,18 @@ class TypeWatch:
     def check(self) -> None:
         """Look at the graph now; what was seen once stays seen (a node may exit later)."""
         with self._lock:
+            if self.closed:
+                return
             subscribed, published = dict(self.subscribed), dict(self.published)
         found = mismatches(self.node, subscribed, ignore=self.ignore) + mismatches(
             self.node, published, publishers=False, ignore=self.ignore)
         with self._lock:
             self._seen.update(found)
+
+    def close(self) -> None:
+        """The node is going: no more looks, what was seen stays."""
+        with self._lock:
+            self.closed = True
 
     @property
     def seen(self) -> list[Mismatch]:
@@ -90,16 +98,12 @@ def watch_world_cmd_vel(watch: TypeWatch, cmd_vel_type: str | None) -> None:
         watch.takes(CMD_VEL_TOPIC, full_name(cmd_vel_type))
 
 
-@pytest.fixture(autouse=True)
-def _message_types(request: pytest.FixtureRequest) -> Iterator[None]:
-    """After each test, note the type mismatches seen so far for the reporter, which puts
-    them in front of a failing test's message."""
-    if "probe" not in request.fixturenames or settings_key not in request.config.stash:
-        yield
-        return
-    probe = request.getfixturevalue("probe")
-    yield
-    probe.types.check()
-    text = note(probe.types.seen)
-    if text:
-        request.node.stash[type_note_key] = text
+def type_note(item: pytest.Item) -> str:
+    """What the test module's probe saw of types that never match, after a last look (the
+    paragraph a failed test's feedback starts with; "" when all types match)."""
+    for node in reversed(item.listchain()):
+        watch = node.stash.get(type_watch_key, None)
+        if watch is not None:
+            watch.check()
+            return note(watch.seen)
+    return ""

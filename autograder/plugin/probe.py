@@ -138,6 +138,8 @@ class Probe:
             pass
 
     def close(self) -> None:
+        self.types.check()  # a last look while the node is on the graph
+        self.types.close()
         self._executor.shutdown(timeout_sec=2.0)
         self.node.destroy_node()
         self._thread.join(2.0)

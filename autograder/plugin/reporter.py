@@ -22,7 +22,8 @@ from autograder.core.output import (
 )
 from autograder.core.report import RawTest
 from autograder.i18n import _
-from autograder.plugin.stash import credit_key, evidence_key, type_note_key
+from autograder.plugin.msgtypes import type_note
+from autograder.plugin.stash import credit_key, evidence_key
 
 
 def _label(item: pytest.Item) -> str:
@@ -123,8 +124,8 @@ class GradingReporter:
                 _update(entry, **_classify(call.excinfo))
         elif call.when == "teardown" and outcome_report.failed and entry.status == "passed":
             _update(entry, **_classify(call.excinfo))
-        if call.when == "teardown":
-            _lead_with(entry, item.stash.get(type_note_key, ""))
+        if call.when == "teardown" and entry.status == "failed":
+            _lead_with(entry, type_note(item))
         _bound(entry)
 
     def pytest_runtest_logfinish(self, nodeid: str) -> None:

@@ -13,7 +13,7 @@ import pytest
 
 from autograder.core.errors import StudentFailure
 from autograder.plugin.probe import WORLD_NODE_NAME
-from autograder.plugin.stash import reporter_key, settings_key
+from autograder.plugin.stash import reporter_key, settings_key, type_watch_key
 
 if TYPE_CHECKING:
     from rclpy.context import Context
@@ -108,11 +108,14 @@ def world(request: pytest.FixtureRequest, exercise: Exercise,
 
 
 @pytest.fixture(scope="module")
-def probe(ros_context: Context, world: SimBridge) -> Iterator[Probe]:
+def probe(request: pytest.FixtureRequest, ros_context: Context,
+          world: SimBridge) -> Iterator[Probe]:
     """The grader's own node on the graph: publish, subscribe, call, set parameters."""
     from autograder.plugin.probe import Probe
 
     node = Probe(ros_context, world)
+    # For the reporter: what the graph showed of types that never match (msgtypes.py).
+    request.node.stash[type_watch_key] = node.types
     try:
         yield node
     finally:
