@@ -87,6 +87,8 @@ def test_a_twist_stamped_drives_the_robot(graph: Graph) -> None:
                            wall_timeout=WALL)
     assert bridge.cmd_vel_mismatches() == []  # the right type is named nowhere
     publisher.publish(TwistStamped())
+    assert bridge.wait_for(lambda: bridge.world.command == (0.0, 0.0), sim_timeout=3.0,
+                           wall_timeout=WALL)  # stopped: the next test starts still
 
 
 def test_a_twist_publisher_is_named_with_both_types(graph: Graph) -> None:
@@ -96,6 +98,7 @@ def test_a_twist_publisher_is_named_with_both_types(graph: Graph) -> None:
                            sim_timeout=float("inf"), wall_timeout=WALL)
     assert bridge.cmd_vel_mismatches() == [Mismatch(
         "driver", "/cmd_vel", "geometry_msgs/msg/Twist", "geometry_msgs/msg/TwistStamped")]
+    assert bridge.world.command == (0.0, 0.0)
     x0 = bridge.world.pose[0]
     message = Twist()
     message.linear.x = 0.5
