@@ -3,7 +3,7 @@ than the grader's on the same topic (``TwistStamped`` where the robot takes ``Tw
 
 DDS never connects such endpoints and nothing says so: the node would just lose points
 for "nothing on cmd_vel".  The probe watches the graph (:class:`TypeWatch`, every
-``CHECK_EVERY`` of sim time and at each test's end) and the reporter puts what it saw, once,
+``CHECK_EVERY`` of sim time and when a test fails) and the reporter puts what it saw, once,
 before the message of every test that failed, setup failures of module fixtures included.
 """
 
