@@ -5,6 +5,15 @@ the bridge publishes ``/clock`` (the tick's end time) and then the odometry and 
 fell due inside it, so a subscriber's clock has already reached a message's stamp.
 Commands received on ``/cmd_vel`` take effect at the start of the next tick.
 
+What goes out is what a TurtleBot3 on Jazzy gives (REP 105 frames): ``/odom`` is wheel
+odometry in the ``odom`` frame, which starts at (0, 0, 0) where the robot starts, with
+child frame ``base_footprint`` and the wheel speeds as its twist; the world-frame ground
+truth stays in :attr:`SimBridge.recording`.  ``/scan`` is in ``base_scan``, the scanner's
+frame (mounted as the world file's ``lidar.mount`` says), with seeded Gaussian noise and
+REP 117's -inf/+inf.  ``/cmd_vel`` is taken as the world's ``cmd_vel_type``, ``Twist`` or
+``TwistStamped`` (whose ``twist`` drives); :meth:`SimBridge.cmd_vel_mismatches` names the
+publishers of the other type, which the robot cannot hear.
+
 How long a tick is and when the next may go (the real-time factor, at most ``clock_hz``
 ticks per wall second, holding for a busy student process, the start-up hold) is decided
 by :class:`sim.pacing.Pacer`; the bridge only steps the world and publishes.
@@ -28,7 +37,6 @@ from collections.abc import Callable
 from contextlib import AbstractContextManager
 from typing import Any
 
-from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
@@ -37,13 +45,14 @@ from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
 
+from sim.cmdvel import CMD_VEL_TOPIC, MESSAGE_TYPES, Mismatch, full_name, mismatches, twist_of
 from sim.engine import SCAN_HZ, Outputs, Simulation
 from sim.faults import Scan
 from sim.msgdefs import type_name
 from sim.pacing import DEFAULT_CLOCK_HZ, DEFAULT_CPU_BUDGET, HoldOutcome, Pacer, PacingPolicy
 from sim.physics import World
 from sim.recorder import Recording, Sample
-from sim.worldfile import Fault
+from sim.worldfile import CmdVelType, Fault
 
 
 def _stamp(t: float) -> tuple[int, int]:
@@ -61,8 +70,10 @@ class SimBridge:
                  max_clock_hz: float = DEFAULT_CLOCK_HZ, node_name: str = "sim_world",
                  quiescence_cap: float = 2.0, cpu_budget: float = DEFAULT_CPU_BUDGET,
                  poll_interval: float = 0.0005,
-                 settle: float = 0.001, max_tick: float = 2.0) -> None:
+                 settle: float = 0.001, max_tick: float = 2.0,
+                 cmd_vel_type: CmdVelType | None = None) -> None:
         self.sim = Simulation(world)
+        self.cmd_vel_type: CmdVelType = cmd_vel_type or world.spec.cmd_vel_type
         self.world = world
         self.recheck = 0.01
         # Before the node: bad settings (a negative RTF, no clock rate) raise ValueError here.
@@ -80,7 +91,8 @@ class SimBridge:
         self._clock_pub = self.node.create_publisher(Clock, "/clock", qos)
         self._odom_pub = self.node.create_publisher(Odometry, "/odom", qos)
         self._scan_pub = self.node.create_publisher(LaserScan, "/scan", qos)
-        self.node.create_subscription(Twist, "/cmd_vel", self._on_cmd_vel, 10)
+        self.node.create_subscription(MESSAGE_TYPES[self.cmd_vel_type], CMD_VEL_TOPIC,
+                                      self._on_cmd_vel, 10)
         self._executor = SingleThreadedExecutor(context=context)
         self._executor.add_node(self.node)
         self._context = context
@@ -203,6 +215,11 @@ class SimBridge:
         i = bisect.bisect_right(log, wall_ns, key=lambda entry: entry[0]) - 1
         return log[i][1] if i >= 0 else 0.0
 
+    def cmd_vel_mismatches(self) -> list[Mismatch]:
+        """Publishers on /cmd_vel whose type is not the one this robot takes."""
+        return mismatches(self.node, {CMD_VEL_TOPIC: full_name(self.cmd_vel_type)},
+                          ignore=(self.node.get_name(),))
+
     def wait_until(self, sim_time: float, wall_timeout: float) -> bool:
         """Block until sim time reaches ``sim_time``; False if ``wall_timeout`` passes first."""
         with self._cond:
@@ -228,8 +245,9 @@ class SimBridge:
             return True
 
     # -- threads --------------------------------------------------------------------
-    def _on_cmd_vel(self, msg: Twist) -> None:
-        self._cmd = (msg.linear.x, msg.angular.z)
+    def _on_cmd_vel(self, msg: object) -> None:
+        twist = twist_of(msg)
+        self._cmd = (twist.linear.x, twist.angular.z)
         self._tap("/cmd_vel", msg, self.world.time)
 
     def _spin(self) -> None:
@@ -258,10 +276,10 @@ class SimBridge:
         self._clock_pub.publish(clock)
         self._tap("/clock", clock, self.world.time)
         for out in outputs:
-            if out.odom is not None:
-                odom = self._odometry(out.odom)
+            if out.wheel_odom is not None:
+                odom = self._odometry(out.wheel_odom)
                 self._odom_pub.publish(odom)
-                self._tap("/odom", odom, out.odom.t)
+                self._tap("/odom", odom, out.wheel_odom.t)
             if out.scan is not None:
                 scan = self._laser_scan(out.scan)
                 self._scan_pub.publish(scan)

@@ -8,6 +8,7 @@ that way, while ``sim`` itself knows nothing of the autograder.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import os
@@ -105,9 +106,12 @@ def check_command(file: Path) -> None:
               show_default=True,
               help="Most /clock messages per wall second (as graded: Jazzy's "
                    "MultiThreadedExecutor stutters from about 50 Hz).")
+@click.option("--cmd-vel-type", type=click.Choice(["Twist", "TwistStamped"]), default=None,
+              help="Message type the robot takes on /cmd_vel (default: the world's, "
+                   "usually Twist; Jazzy's TurtleBot3 takes TwistStamped).")
 def run_command(world_name: str, rtf: float, duration: float | None, domain: int | None,
                 record: Path | None, svg: Path | None, bag: Path | None, seed: int | None,
-                clock_hz: float) -> None:
+                clock_hz: float, cmd_vel_type: str | None) -> None:
     """Run a world on a ROS domain so a node can drive the robot.
 
     Start your node in another terminal with the same ROS_DOMAIN_ID:
@@ -116,6 +120,8 @@ def run_command(world_name: str, rtf: float, duration: float | None, domain: int
         python my_node.py --ros-args -p use_sim_time:=true
     """
     spec = _load(world_name)
+    if cmd_vel_type is not None:
+        spec = dataclasses.replace(spec, cmd_vel_type=cmd_vel_type)
     summary = run_world(spec, rtf=rtf, duration=duration, domain=_domain(domain), seed=seed,
                         record=record, svg=svg, clock_hz=clock_hz, bag=bag,
                         companion=click.get_current_context().meta.get(COMPANION))
@@ -148,6 +154,7 @@ def run_world(spec, *, rtf: float, duration: float | None, domain: int,  # noqa:
     click.echo(_("World {name} on ROS domain {domain}, RTF {rtf}. Ctrl-C stops.").format(
         name=spec.name, domain=domain, rtf=rtf or _("max")))
     notes: list[str] = []
+    warned: set[object] = set()
     try:
         if companion is not None:
             bridge.pause()  # simulation time starts only once the companion is up
@@ -162,6 +169,7 @@ def run_world(spec, *, rtf: float, duration: float | None, domain: int,  # noqa:
 
         while not over():
             bridge.wait_for(over, sim_timeout=math.inf, wall_timeout=0.5)
+            _warn_mismatches(bridge, warned)
     except KeyboardInterrupt:
         pass
     finally:
@@ -306,13 +314,26 @@ def _recorder(folder: Path, bridge, world: str):  # noqa: ANN001, ANN202 - SimBr
     return recorder
 
 
+def _warn_mismatches(bridge, warned: set[object]) -> None:  # noqa: ANN001
+    """Say once of each publisher on /cmd_vel whose type the robot does not take."""
+    from sim.cmdvel import world_warning
+
+    for mismatch in bridge.cmd_vel_mismatches():
+        if mismatch not in warned:
+            warned.add(mismatch)
+            click.echo(world_warning(mismatch), err=True)
+
+
 def _summary(spec, bridge, effective: float) -> str:  # noqa: ANN001
     samples, collisions = bridge.recording.snapshot()
     x, y, theta = bridge.world.pose
+    ox, oy, otheta = bridge.sim.odometry.pose
     lines = [
         _("Sim time: {t:.2f} s (measured RTF {rtf:.2f})").format(t=bridge.now, rtf=effective),
         _("Final pose: x={x:.3f} m, y={y:.3f} m, theta={theta:.3f} rad").format(
             x=x, y=y, theta=theta),
+        _("Odometry (odom frame, from the wheels): x={x:.3f} m, y={y:.3f} m, "
+          "theta={theta:.3f} rad").format(x=ox, y=oy, theta=otheta),
         _("Distance travelled: {d:.2f} m").format(d=bridge.recording.distance()),
         _("Collisions: {n}").format(n=len(collisions)),
     ]

@@ -15,7 +15,7 @@ import math
 from collections.abc import Collection, Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, Any, Literal
 
 from sim.content import ContentError, Document, build, load_document
 from sim.faultkinds import KINDS, kind_names
@@ -26,6 +26,11 @@ TITLE_CONTEXT = "world"
 """The gettext context of world titles (``messages`` domain, see :func:`extract_world`)."""
 ROBOT_RADIUS = 0.105
 """TurtleBot3-like footprint radius (m): the robot is a disc of this size."""
+LIDAR_NOISE_SIGMA = 0.01
+"""m: the Gaussian range noise of TurtleBot3's Gazebo LDS model."""
+LIDAR_MOUNT = (-0.032, 0.0, 0.0)
+"""(x, y, yaw) of ``base_scan`` in ``base_footprint``: TurtleBot3 Burger's scan joint."""
+CmdVelType = Literal["Twist", "TwistStamped"]
 
 Point = tuple[float, float]
 Segment = tuple[Point, Point]
@@ -93,6 +98,19 @@ class RobotLimits:
 
 
 @dataclass(frozen=True)
+class LidarSpec:
+    """The laser scanner: where it sits on the robot, its range and its noise (LDS-01-like)."""
+
+    beams: int = _f(360, "readings per turn, counter-clockwise from straight ahead")
+    range_min: float = _f(0.12, "nearest reading (m); closer hits read -inf (REP 117)")
+    range_max: float = _f(3.5, "farthest reading (m); nothing within it reads +inf (REP 117)")
+    noise_sigma: float = _f(LIDAR_NOISE_SIGMA, "standard deviation of the Gaussian noise "
+                            "on each reading in range (m), drawn from the world's seed")
+    mount: tuple[float, float, float] = _f(LIDAR_MOUNT, "[x, y, yaw] of base_scan in "
+                                           "base_footprint (m, m, rad)")
+
+
+@dataclass(frozen=True)
 class Fault:
     """A fault to inject: a corrupted or missing scan for a time span, or a new obstacle."""
 
@@ -118,8 +136,12 @@ class WorldSpec:
     start: Pose = _f(None, "the robot's start pose (default: the arena's centre, facing +x)")
     goal: Goal | None = _f(None, "optional goal region")
     limits: RobotLimits = _f(RobotLimits, "the robot's speed and acceleration limits")
+    lidar: LidarSpec = _f(LidarSpec, "the laser scanner on /scan")
+    cmd_vel_type: CmdVelType = _f("Twist", "message type the robot takes on /cmd_vel: "
+                                  "Twist (the textbook's) or TwistStamped (Jazzy's "
+                                  "TurtleBot3 and its Gazebo bridge)")
     faults: tuple[Fault, ...] = _f((), "faults injected during the run")
-    seed: int = _f(0, "seed for everything random (faults that pick beams)")
+    seed: int = _f(0, "seed for everything random (faults that pick beams, lidar noise)")
 
     def __post_init__(self) -> None:
         if self.start is None:  # the centre of whatever size was given
@@ -172,6 +194,17 @@ def _validate_fault_kind(doc: Document, fault: Fault, i: int) -> None:
         raise doc.error(problem, "faults", i, "kind")
 
 
+def _validate_lidar(doc: Document, lidar: LidarSpec) -> None:
+    _positive(doc, lidar.beams, "lidar", "beams")
+    _positive(doc, lidar.range_min, "lidar", "range_min")
+    if not lidar.range_max > lidar.range_min:
+        raise doc.error(_("range_max must be above range_min, found {value}").format(
+            value=lidar.range_max), "lidar", "range_max")
+    if not lidar.noise_sigma >= 0:
+        raise doc.error(_("noise_sigma must not be negative, found {value}").format(
+            value=lidar.noise_sigma), "lidar", "noise_sigma")
+
+
 def _validate(doc: Document, spec: WorldSpec) -> None:
     """Checks the types alone cannot express, each naming the offending field."""
     w, h = spec.size
@@ -181,6 +214,7 @@ def _validate(doc: Document, spec: WorldSpec) -> None:
     for name in ("max_linear_speed", "max_angular_speed", "max_linear_accel",
                  "max_angular_accel"):
         _positive(doc, getattr(spec.limits, name), "limits", name)
+    _validate_lidar(doc, spec.lidar)
     for i, box in enumerate(spec.obstacles.boxes):
         _positive(doc, box.size[0], "obstacles", "boxes", i, "size", 0)
         _positive(doc, box.size[1], "obstacles", "boxes", i, "size", 1)

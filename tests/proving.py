@@ -291,6 +291,17 @@ def failures(result: RunResult) -> dict[str, str]:
     return {t.name: f"{t.status}: {t.message}" for t in result.tests if t.status != "passed"}
 
 
+_BOTH_TYPES = (re.compile(r"geometry_msgs/msg/Twist\b"),
+               re.compile(r"geometry_msgs/msg/TwistStamped\b"))
+
+
+def without_both_types(result: RunResult) -> dict[str, str]:
+    """The lost tests whose feedback does not name both Twist and TwistStamped: a node
+    written for Jazzy's TurtleBot3 must be told why its commands never arrived."""
+    return {t.name: t.message for t in result.tests if t.status != "passed"
+            and not all(pattern.search(t.message) for pattern in _BOTH_TYPES)}
+
+
 def test_reference_scores_full_marks_every_time(graded: dict[str, RunResult],
                                                 proof: Proof) -> None:
     results = [graded[f"reference#{i}"] for i in range(proof.repeats)]

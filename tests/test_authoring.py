@@ -80,6 +80,19 @@ def test_malformed_exercise_file_names_file_line_and_field(course):
     assert "Traceback" not in result.output
 
 
+def test_cmd_vel_type_is_the_worlds_unless_the_exercise_says(course):
+    assert load_exercise(shout(course)).cmd_vel_type is None  # the world's (Twist)
+    path = shout(course) / "exercise.yaml"
+    text = path.read_text()
+    path.write_text(text + "cmd_vel_type: TwistStamped\n")
+    assert load_exercise(shout(course)).cmd_vel_type == "TwistStamped"
+    path.write_text(text + "cmd_vel_type: twist\n")
+    problems = [str(p) for p in validate(course, run_gradings=False)]
+    line = len(text.splitlines()) + 1
+    assert any(p.startswith(f"{path}:{line}: cmd_vel_type: must be one of 'Twist', "
+                            "'TwistStamped'") for p in problems), problems
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("broken,where", [
     ("def test_x(:\n    pass\n", "test_broken.py"),                      # does not import

@@ -11,7 +11,7 @@ from __future__ import annotations
 from fractions import Fraction
 
 import pytest
-from proving import Proof
+from proving import Proof, without_both_types
 
 pytestmark = pytest.mark.slow
 
@@ -35,3 +35,9 @@ def test_a_collision_is_named(graded):
     message = by_name["test_corridor_reaches_goal"].message
     assert "hit wall" in message
     assert by_name["test_corridor_reaches_goal"].score < 1
+
+
+def test_a_twist_stamped_node_is_told_both_types(graded):
+    """The reference solution publishing TwistStamped, as for Jazzy's TurtleBot3: every test
+    it loses says what it sent and what this exercise's robot takes."""
+    assert without_both_types(graded["twist_stamped"]) == {}

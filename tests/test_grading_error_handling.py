@@ -12,7 +12,7 @@ from __future__ import annotations
 import re
 
 import pytest
-from proving import Proof
+from proving import Proof, without_both_types
 
 pytestmark = pytest.mark.slow
 
@@ -49,3 +49,9 @@ def test_driving_into_what_is_ahead_is_told_which_beam_is_front(graded):
     assert "beam 0 of /scan is straight ahead" in message
     assert "ranges[len(ranges)//2] is straight behind" in message
     assert message.count("straight ahead.") == 1
+
+
+def test_a_twist_stamped_node_is_told_both_types(graded):
+    """The reference solution publishing TwistStamped, as for Jazzy's TurtleBot3: every test
+    it loses says what it sent and what this exercise's robot takes."""
+    assert without_both_types(graded["twist_stamped"]) == {}

@@ -9,7 +9,7 @@ score and a plain message.
 from __future__ import annotations
 
 import pytest
-from proving import Proof, failed_tests
+from proving import Proof, failed_tests, without_both_types
 
 pytestmark = pytest.mark.slow
 
@@ -57,3 +57,9 @@ def test_node_that_never_spins_fails_what_needs_spinning(graded):
     for name in ("test_clamps_linear", "test_refuses_out_of_range"):
         assert by_name[name].score == 0
         assert "spinning" in by_name[name].hint + by_name[name].message
+
+
+def test_a_twist_stamped_node_is_told_both_types(graded):
+    """The reference solution publishing TwistStamped, as for Jazzy's TurtleBot3: every test
+    it loses says what it sent and what this exercise's robot takes."""
+    assert without_both_types(graded["twist_stamped"]) == {}

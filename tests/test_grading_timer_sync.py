@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import pytest
 from designs import read_design
-from proving import Proof
+from proving import Proof, without_both_types
 
 from autograder.core.exercise import find_exercise
 
@@ -63,3 +63,9 @@ def test_frozen_clock_is_explained(graded):
     test = by_name["test_control_rate"]
     assert "stopped" in test.message
     assert "/clock" in test.hint and "MultiThreadedExecutor" in test.hint
+
+
+def test_a_twist_stamped_node_is_told_both_types(graded):
+    """The reference solution publishing TwistStamped, as for Jazzy's TurtleBot3: every test
+    it loses says what it sent and what this exercise's robot takes."""
+    assert without_both_types(graded["twist_stamped"]) == {}

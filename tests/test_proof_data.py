@@ -23,6 +23,7 @@ from proving import (
     load_variant,
     load_variants,
     make_patch,
+    without_both_types,
 )
 
 from autograder.core.exercise import find_exercise
@@ -199,3 +200,22 @@ def test_the_once_check_fails_on_a_hint_repeated_in_its_message() -> None:
     proving.test_each_hint_is_given_once(_graded("It failed.", "Fix it."))
     with pytest.raises(AssertionError):
         proving.test_each_hint_is_given_once(_graded("It failed. Fix it.", "Fix it."))
+
+
+def test_both_velocity_types_must_be_named_in_every_lost_test() -> None:
+    from fractions import Fraction
+
+    from autograder.core.results import RunResult, TestResult
+
+    def result(*messages: str) -> RunResult:
+        return RunResult("exercise", "x", "X", tuple(
+            TestResult(f"test_{i}", "", Fraction(0), Fraction(1), "failed", message)
+            for i, message in enumerate(messages)) + (
+            TestResult("test_ok", "", Fraction(1), Fraction(1), "passed"),))
+
+    both = ("publishes geometry_msgs/msg/TwistStamped on /cmd_vel, but this robot takes "
+            "geometry_msgs/msg/Twist (its cmd_vel_type)")
+    assert without_both_types(result(both, both)) == {}
+    stamped_only = "publishes geometry_msgs/msg/TwistStamped on /cmd_vel"
+    assert without_both_types(result(both, stamped_only, "nothing on cmd_vel")) == {
+        "test_1": stamped_only, "test_2": "nothing on cmd_vel"}

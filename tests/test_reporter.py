@@ -171,6 +171,58 @@ def test_partial_credit_is_a_failure_with_its_fraction(pytester: pytest.Pytester
     assert entry["fraction"] is None
 
 
+def test_a_type_mismatch_leads_every_failure_once(pytester: pytest.Pytester) -> None:
+    """What the module's probe saw of types that never match (plugin/msgtypes.py) comes
+    first in each failed test's message, once, a module fixture's failure included; a pass
+    or our own error does not get it."""
+    tests = grade_tests(pytester, '''
+        import pytest
+        from autograder.core.errors import StudentFailure
+        from autograder.plugin.stash import type_watch_key
+        from sim.cmdvel import Mismatch
+
+        class Watch:
+            seen = [Mismatch("ai_agent", "/cmd_vel", "geometry_msgs/msg/TwistStamped",
+                             "geometry_msgs/msg/Twist")]
+
+            def check(self):
+                pass
+
+        @pytest.fixture(scope="module", autouse=True)
+        def watch(request):
+            request.node.stash[type_watch_key] = Watch()
+
+        @pytest.fixture(scope="module")
+        def run():
+            raise StudentFailure("the node never drove")
+
+        def test_nothing_came():
+            raise StudentFailure("nothing on cmd_vel", "publish it")
+
+        def test_part_of_the_way(credit):
+            credit.award(0.5, "half")
+
+        def test_passes():
+            pass
+
+        def test_our_bug():
+            raise RuntimeError("ours")
+
+        def test_needs_the_run(run):
+            pass
+    ''')
+    note = ("Your node 'ai_agent' publishes geometry_msgs/msg/TwistStamped on /cmd_vel, but "
+            "this exercise's robot takes geometry_msgs/msg/Twist (its cmd_vel_type), so the "
+            "robot never hears it: publish Twist.")
+    assert tests["test_nothing_came"]["message"] == f"{note}\n\nnothing on cmd_vel"
+    assert tests["test_nothing_came"]["hint"] == "publish it"
+    assert tests["test_part_of_the_way"]["message"] == f"{note}\n\nhalf"
+    assert tests["test_part_of_the_way"]["fraction"] == 0.5
+    assert tests["test_needs_the_run"]["message"] == f"{note}\n\nthe node never drove"
+    assert tests["test_passes"]["message"] == ""
+    assert tests["test_our_bug"]["message"] == "RuntimeError: ours"
+
+
 def test_a_teardown_failure_after_a_pass_is_classified(pytester: pytest.Pytester) -> None:
     """As the graph guard does: a fixture that finds tampering after the test fails it."""
     tests = grade_tests(pytester, '''

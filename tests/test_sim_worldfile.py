@@ -11,7 +11,7 @@ import yaml
 
 from sim.content import ContentError
 from sim.faultkinds import KINDS
-from sim.worldfile import ROBOT_RADIUS, WorldSpec, load_world, world_names
+from sim.worldfile import ROBOT_RADIUS, LidarSpec, WorldSpec, load_world, world_names
 
 
 def test_shipped_worlds_load() -> None:
@@ -73,6 +73,14 @@ BAD = {
                               3, "faults.1.length", "unknown field"),
     "obstacle-with-end": ("faults:\n  - kind: obstacle\n    box: {center: [1, 1], "
                           "size: [1, 1]}\n    end: 3\n", 4, "faults.0.end", "unknown field"),
+    "bad-cmd-vel-type": ("cmd_vel_type: Twistd\n", 1, "cmd_vel_type", "one of 'Twist'"),
+    "negative-noise": ("lidar:\n  noise_sigma: -0.01\n", 2, "lidar.noise_sigma",
+                       "not be negative"),
+    "short-mount": ("lidar:\n  mount: [0.1, 0]\n", 2, "lidar.mount", "3 items"),
+    "range-max-below-min": ("lidar: {range_min: 0.5, range_max: 0.4}\n", 1,
+                            "lidar.range_max", "above range_min"),
+    "no-beams": ("lidar:\n  beams: 0\n", 2, "lidar.beams", "positive"),
+    "unknown-lidar-field": ("lidar:\n  sigma: 0.1\n", 2, "lidar.sigma", "unknown field"),
 }
 
 
@@ -99,6 +107,24 @@ def test_missing_required_field_in_a_fault(tmp_path: Path) -> None:
     with pytest.raises(ContentError) as info:
         load_world(path)
     assert info.value.line == 2 and info.value.field == "faults.0.kind"
+
+
+def test_lidar_and_cmd_vel_type_default_to_a_turtlebot3_and_the_textbook() -> None:
+    spec = load_world("empty_room")
+    assert spec.lidar == LidarSpec()
+    assert (spec.lidar.noise_sigma, spec.lidar.mount) == (0.01, (-0.032, 0.0, 0.0))
+    assert (spec.lidar.beams, spec.lidar.range_min, spec.lidar.range_max) == (360, 0.12, 3.5)
+    assert spec.cmd_vel_type == "Twist"
+
+
+def test_lidar_and_cmd_vel_type_from_the_file(tmp_path: Path) -> None:
+    path = tmp_path / "tb3.yaml"
+    path.write_text("cmd_vel_type: TwistStamped\nlidar:\n  noise_sigma: 0.02\n"
+                    "  mount: [0.05, 0.0, 3.14159]\n  range_max: 8\n")
+    spec = load_world(path)
+    assert spec.cmd_vel_type == "TwistStamped"
+    assert spec.lidar == LidarSpec(noise_sigma=0.02, mount=(0.05, 0.0, 3.14159),
+                                   range_max=8.0)
 
 
 def test_start_pose_angle_is_free() -> None:

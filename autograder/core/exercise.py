@@ -53,6 +53,10 @@ class Exercise:
         "Fraction of the points needed to pass."))
     world: str = dataclasses.field(default="empty_room", metadata=_doc(
         "World the tests run in: a name under sim/worlds or a path relative to the exercise."))
+    cmd_vel_type: Literal["Twist", "TwistStamped"] | None = dataclasses.field(
+        default=None, metadata=_doc(
+            "Message type the robot takes on /cmd_vel, overriding the world's: Twist (the "
+            "textbook's code) or TwistStamped (Jazzy's TurtleBot3 and its Gazebo bridge)."))
     real_time_factor: float = dataclasses.field(default=1.0, metadata=_doc(
         "Pace of simulation time against wall time (0: as fast as the graph keeps up)."))
     clock_hz: float = dataclasses.field(default=DEFAULT_CLOCK_HZ, metadata=_doc(

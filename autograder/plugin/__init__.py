@@ -13,8 +13,9 @@ the simulated ``world``, the student's running node (``student``, ``start_node``
 
 The modules: ``reporter`` (outcomes into the raw report), ``world`` (exercise, rclpy
 context, world and probe fixtures), ``student`` (starting and watching the student's
-program), ``guard`` (tampering), ``credit`` (partial credit and evidence), ``probe`` (the
-grader's node), ``stash`` (the plugin's state on pytest's config).
+program), ``guard`` (tampering), ``msgtypes`` (message types that never match the
+grader's), ``credit`` (partial credit and evidence), ``probe`` (the grader's node),
+``stash`` (the plugin's state on pytest's config).
 """
 
 from __future__ import annotations

@@ -24,6 +24,7 @@ from rclpy.qos import QoSProfile, ReliabilityPolicy
 
 from autograder.core.errors import GraderError, StudentFailure
 from autograder.i18n import _
+from autograder.plugin.msgtypes import CHECK_EVERY, TypeWatch, watch_world_cmd_vel
 from sim.bag import Tap
 from sim.msgdefs import type_name
 
@@ -125,11 +126,15 @@ class Probe:
                          parameter_overrides=[Parameter("use_sim_time", value=True)])
         self._executor = SingleThreadedExecutor(context=context)
         self._executor.add_node(self.node)
-        self._thread = threading.Thread(target=self._spin, daemon=True, name="probe-executor")
-        self._thread.start()
         self._publishers: dict[str, Any] = {}
         self._taps: list[Tap] = []
         self._subscribed: set[str] = set()
+        # Endpoints of the student's whose type never matches the grader's (msgtypes.py).
+        self.types = TypeWatch(self.node, GRADER_NODES)
+        watch_world_cmd_vel(self.types, getattr(world, "cmd_vel_type", None))
+        self.node.create_timer(CHECK_EVERY, self.types.check)  # in simulation time
+        self._thread = threading.Thread(target=self._spin, daemon=True, name="probe-executor")
+        self._thread.start()
 
     def add_tap(self, tap: Tap) -> None:
         """Hand ``tap(topic, type name, message, sim time)`` each message this probe receives
@@ -155,6 +160,8 @@ class Probe:
             pass
 
     def close(self) -> None:
+        self.types.check()  # a last look while the node is on the graph
+        self.types.close()
         self._executor.shutdown(timeout_sec=2.0)
         self.node.destroy_node()
         self._thread.join(2.0)
@@ -224,13 +231,11 @@ class Probe:
         else:
             inbox.subscription = self.node.create_subscription(
                 msg_type, topic, lambda m: self._received(name, inbox, self.now, m), qos)
+        self.types.takes(inbox.subscription.topic_name, type_name(msg_type))
         return inbox
 
     def publish(self, msg_type: type, topic: str, message: Any) -> None:
-        publisher = self._publishers.get(topic)
-        if publisher is None:
-            publisher = self.node.create_publisher(msg_type, topic, 10)
-            self._publishers[topic] = publisher
+        publisher = self._publisher(msg_type, topic)
         publisher.publish(message)
         name = publisher.topic_name
         if name not in (*getattr(self.world, "SUBSCRIBES", ()), *self._subscribed):
@@ -238,10 +243,16 @@ class Probe:
 
     def wait_for_subscriber(self, msg_type: type, topic: str, sim_timeout: float = 5.0) -> bool:
         """Wait until someone subscribes to ``topic`` (so our first message is not lost)."""
-        if topic not in self._publishers:
-            self._publishers[topic] = self.node.create_publisher(msg_type, topic, 10)
-        publisher = self._publishers[topic]
+        publisher = self._publisher(msg_type, topic)
         return self.wait_for(lambda: publisher.get_subscription_count() > 0, sim_timeout)
+
+    def _publisher(self, msg_type: type, topic: str) -> Any:
+        publisher = self._publishers.get(topic)
+        if publisher is None:
+            publisher = self.node.create_publisher(msg_type, topic, 10)
+            self._publishers[topic] = publisher
+            self.types.sends(publisher.topic_name, type_name(msg_type))
+        return publisher
 
     # -- graph -------------------------------------------------------------------------
     def node_names(self) -> set[str]:

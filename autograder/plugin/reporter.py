@@ -24,6 +24,7 @@ from autograder.core.output import (
 from autograder.core.report import RawTest
 from autograder.core.results import exact
 from autograder.i18n import _
+from autograder.plugin.msgtypes import type_note
 from autograder.plugin.stash import credit_key, evidence_key, settings_key
 
 
@@ -140,6 +141,8 @@ class GradingReporter:
                 _update(entry, **_classify(call.excinfo))
         elif call.when == "teardown" and outcome_report.failed and entry.status == "passed":
             _update(entry, **_classify(call.excinfo))
+        if call.when == "teardown" and entry.status == "failed":
+            _lead_with(entry, type_note(item))
         _bound(entry)
 
     def pytest_runtest_logfinish(self, nodeid: str) -> None:
@@ -161,6 +164,13 @@ def _points(item: pytest.Item) -> Any:
 def _update(entry: RawTest, **values: Any) -> None:
     for key, value in values.items():
         setattr(entry, key, value)
+
+
+def _lead_with(entry: RawTest, note: str) -> None:
+    """Put ``note`` (why messages never matched, say) once before a failed test's message:
+    it is what the student must fix first."""
+    if note and entry.status == "failed" and note not in entry.message:
+        entry.message = f"{note}\n\n{entry.message}" if entry.message else note
 
 
 def _bound(entry: RawTest) -> None:

@@ -16,5 +16,7 @@ settings_key = pytest.StashKey[RunSettings]()
 reporter_key = pytest.StashKey["GradingReporter"]()
 credit_key = pytest.StashKey["Credit"]()
 evidence_key = pytest.StashKey["Evidence"]()
+# On a test module: the probe's watch on message types (plugin/msgtypes.py).
+type_watch_key = pytest.StashKey["TypeWatch"]()
 # The student's node failed to appear once: later starts in the run fail at once.
 startup_key = pytest.StashKey[StudentFailure]()

@@ -14,7 +14,7 @@ import pytest
 from autograder.core.errors import StudentFailure
 from autograder.plugin.bag import attach_probe, close_bag, open_bag
 from autograder.plugin.probe import WORLD_NODE_NAME
-from autograder.plugin.stash import reporter_key, settings_key
+from autograder.plugin.stash import reporter_key, settings_key, type_watch_key
 
 if TYPE_CHECKING:
     from rclpy.context import Context
@@ -94,7 +94,8 @@ def world(request: pytest.FixtureRequest, exercise: Exercise,
     bridge = SimBridge(World(spec), ros_context, node_name=WORLD_NODE_NAME,
                        max_clock_hz=exercise.clock_hz,
                        cpu_budget=exercise.cpu_budget,
-                       real_time_factor=exercise.real_time_factor if rtf is None else rtf)
+                       real_time_factor=exercise.real_time_factor if rtf is None else rtf,
+                       cmd_vel_type=exercise.cmd_vel_type)
     bag = open_bag(request, bridge, spec.name)
     bridge.start()
     try:
@@ -117,6 +118,8 @@ def probe(request: pytest.FixtureRequest, ros_context: Context,
 
     node = Probe(ros_context, world)
     attach_probe(request, node)
+    # For the reporter: what the graph showed of types that never match (msgtypes.py).
+    request.node.stash[type_watch_key] = node.types
     try:
         yield node
     finally:

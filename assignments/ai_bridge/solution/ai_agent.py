@@ -8,9 +8,10 @@ the agent's action into velocity commands; report the outcome on a topic.
 
 Prerequisites: publishers, subscribers, timers and parameters in one node; NumPy arrays.
 
-Expected output: started with `-p goal_x:=1.5 -p goal_y:=4.8` in the open room, the robot
-turns, drives to the goal, stops within 0.3 m of it and publishes "goal reached" on
-agent_status; it never touches an obstacle on the way.
+Expected output: started with `-p goal_x:=-1.5 -p goal_y:=1.8` in the open room (the goal
+in the odom frame, which starts where the robot starts: 1.5 m behind it, 1.8 m to its
+left), the robot turns, drives to the goal, stops within 0.3 m of it and publishes "goal
+reached" on agent_status; it never touches an obstacle on the way.
 """
 import math
 import sys

@@ -1,7 +1,8 @@
 """The agent's run to a goal, watched from the world, and how it is judged.
 
 The world records the robot's pose and speed at 50 Hz and every collision; the grader
-never asks the node where it thinks it is.
+never asks the node where it thinks it is.  The node is given its goal in the frame it
+has, ``odom`` (REP 105: where the robot started), and judged in the world's.
 """
 
 from __future__ import annotations
@@ -15,6 +16,8 @@ from std_msgs.msg import String
 from autograder.core.errors import StudentFailure
 from autograder.i18n import _
 from autograder.plugin.collisions import with_front_beam_note
+from sim.odometry import to_odom
+from sim.worldfile import load_world
 
 REACHED = 0.3              # m from the goal: inside counts as reached
 STILL = 0.02               # m/s: slower than this counts as stopped
@@ -23,6 +26,13 @@ STALLED = 5.0              # s standing still, once moving, away from the goal e
 # Path length over the straight start-to-goal distance: up to FULL earns the whole bonus,
 # from NONE on nothing.
 FULL, NONE = 1.5, 2.5
+
+
+def goal_parameters(world: str) -> dict[str, float]:
+    """``goal_x``/``goal_y`` for ``world``: its goal in the odom frame of its start pose."""
+    spec = load_world(world)
+    x, y = to_odom(spec.start, spec.goal.x, spec.goal.y)
+    return {"goal_x": round(x, 6), "goal_y": round(y, 6)}
 
 
 @dataclass

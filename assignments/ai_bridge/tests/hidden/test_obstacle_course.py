@@ -1,16 +1,14 @@
 """Hidden tests: corner to corner across a room, with obstacles on the straight line."""
 
 import pytest
-from helpers import judge_efficiency, judge_reached
+from helpers import goal_parameters, judge_efficiency, judge_reached
 
 from autograder.i18n import _
-from sim.worldfile import load_world
 
 WORLD = "obstacle_course"
-GOAL = load_world(WORLD).goal
 LIMIT = 60.0
 pytestmark = [pytest.mark.world(WORLD),
-              pytest.mark.parameters({"goal_x": GOAL.x, "goal_y": GOAL.y})]
+              pytest.mark.parameters(goal_parameters(WORLD))]
 
 
 @pytest.mark.points(3)

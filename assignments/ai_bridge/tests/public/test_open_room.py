@@ -1,17 +1,15 @@
 """Public tests: in an open room, the agent turns, drives to its goal, stops and says so."""
 
 import pytest
-from helpers import REACHED, STATUS_WITHIN, judge_efficiency, judge_reached
+from helpers import REACHED, STATUS_WITHIN, goal_parameters, judge_efficiency, judge_reached
 
 from autograder.core.errors import StudentFailure
 from autograder.i18n import _
-from sim.worldfile import load_world
 
 WORLD = "open_room"
-GOAL = load_world(WORLD).goal
 LIMIT = 40.0  # simulation seconds to arrive
 pytestmark = [pytest.mark.world(WORLD),
-              pytest.mark.parameters({"goal_x": GOAL.x, "goal_y": GOAL.y})]
+              pytest.mark.parameters(goal_parameters(WORLD))]
 
 
 @pytest.mark.points(3)

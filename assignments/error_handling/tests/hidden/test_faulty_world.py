@@ -2,7 +2,8 @@
 
 The faults are injected relative to the moment the node first drives, between scans (a
 fault span starts and ends 0.05 s after a scan), so the same scans are affected in
-every run.  Speeds are the world's own measurements (odometry, recorded at 50 Hz).
+every run.  Speeds are the world's own measurements (ground truth, recorded at 50 Hz,
+not the wheel odometry on /odom).
 """
 
 from __future__ import annotations
