@@ -175,6 +175,12 @@ def _forged(exercise: Exercise, elapsed: float) -> RunResult:
                      execution_time=elapsed, data={"forged": True})
 
 
+def _module_of(nodeid: str) -> str:
+    """The test module's file name, as the world's recordings are keyed
+    ("tests/public/test_governor.py::test_clamps" -> "test_governor.py")."""
+    return nodeid.partition("::")[0].rpartition("/")[2]
+
+
 def _result(exercise: Exercise, raw_report: RawReport, returncode: int | None,
             timed_out: bool, pytest_log: str, elapsed: float,
             all_tests: bool = True) -> RunResult:
@@ -196,7 +202,9 @@ def _result(exercise: Exercise, raw_report: RawReport, returncode: int | None,
             name=raw.name, label=raw.label,
             score=_score(status, max_score, raw.fraction), max_score=max_score,
             status=status, message=message, hint=raw.hint, visibility=raw.visibility,
-            reveal=raw.reveal, details=raw.details, data={"charts": raw.charts}))
+            reveal=raw.reveal, details=raw.details,
+            # The test module names the world's recording it ran in (report pictures).
+            data={"charts": raw.charts, "module": _module_of(raw.nodeid)}))
     grader_error = None
     details = ""
     broken_run = returncode not in (0, 1) and not timed_out  # e.g. a test file that
