@@ -182,6 +182,17 @@ def test_replay_slider_moves_the_robot_its_scan_and_command(tmp_path: Path) -> N
         figure.screenshot(path=str(tmp_path / "replay.png"))
         figure.locator(".replay-run").select_option("1")  # the other run in this world
         other = page.evaluate(_REPLAY_JS, 0)
+        slider.focus()
+        page.keyboard.press("Home")
+        play = figure.locator(".replay-play")
+        labels = [play.text_content()]
+        play.click()  # plays until the end of the run, or until paused
+        labels.append(play.text_content())
+        page.wait_for_function(
+            "() => Number(document.querySelector('figure.world .replay-time').value) > 1")
+        play.click()
+        labels.append(play.text_content())
+        played = page.evaluate(_REPLAY_JS, 0)
     assert problems == []  # the script ran under the page's policy, without errors
     assert at_start["controls"] and at_start["shown"] == "visible"
     assert at_start["dir"] == "ltr"  # the picture and its numbers, in an Urdu page
@@ -202,3 +213,6 @@ def test_replay_slider_moves_the_robot_its_scan_and_command(tmp_path: Path) -> N
     # The other run: its own length and pose at the same time.
     assert other["max"] == pytest.approx(8.0)
     assert other["transform"] != halfway["transform"]
+    # Play moves the time on by itself; the button says what a click will do.
+    assert labels[0] == labels[2] != labels[1]
+    assert float(played["clock"].split()[0]) > 1.0
