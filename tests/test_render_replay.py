@@ -19,12 +19,15 @@ from autograder.render.html import to_html
 from autograder.render.replay import figures
 from sim.engine import Simulation
 from sim.physics import World
-from sim.worldfile import load_world
+from sim.worldfile import Fault, load_world
 
 
-def recorded(world: str, seconds: float, linear: float = 0.4, turn: float = 0.8) -> dict:
+def recorded(world: str, seconds: float, linear: float = 0.4, turn: float = 0.8,
+             faults: tuple[Fault, ...] = ()) -> dict:
     """A run of the simulated world, driven as a node would (a command every 0.1 s)."""
     sim = Simulation(World(load_world(world)))
+    for fault in faults:
+        sim.inject(fault)
     for i in range(round(seconds / sim.world.dt)):
         if i % 20 == 0:
             sim.set_command(linear, turn * math.sin(i / 300))
@@ -78,10 +81,12 @@ def test_one_figure_per_world_listing_the_tests_that_ran_in_it(result: RunResult
     # never moved is left out, as before.
     assert re.findall(r'<option value="\d">(.*?)</option>', room) == ["test_governor.py",
                                                                    "test_world.py"]
-    items = re.findall(r'<li data-run="(\d)">(.*?)</li>', room, re.S)
-    assert [(i, re.sub(r"<[^>]+>", "", text)) for i, text in items] == [
-        ("0", "test_governor.py: linear.x is clamped; One output per input"),
-        ("1", "test_world.py: The measured speed stays under")]
+    items = re.findall(r'<li data-run="(\d)"><code dir="ltr">(.*?)</code>\s*<ul>(.*?)</ul>',
+                       room, re.S)
+    assert [(i, module, re.findall(r"<li>(.*?)</li>", labels))
+            for i, module, labels in items] == [
+        ("0", "test_governor.py", ["linear.x is clamped", "One output per input"]),
+        ("1", "test_world.py", ["The measured speed stays under"])]
     assert "Tests that ran in this world (2 test files):" in room
     assert "Exits on an invalid override" not in page.split('<h2>What the robot did')[1]
     # One run, no picker; its figure names its test.
@@ -111,6 +116,7 @@ def test_each_run_is_drawn_and_replayable(result: RunResult) -> None:
     assert [t for t, _r in first["scans"]][:3] == pytest.approx([0.1, 0.6, 1.1])
     assert len(first["scans"][0][1]) == 360
     assert first["scan"]["angle_increment"] == pytest.approx(2 * math.pi / 360)
+    assert first["scan_every"] == pytest.approx(0.5)  # older scans are not drawn
 
 
 def test_replay_data_carries_no_english_words(result: RunResult) -> None:

@@ -15,6 +15,7 @@ from browser import chromium_page, fonts_used, ink
 from autograder.core.results import RunResult, TestResult
 from autograder.render.html import to_html
 from sim.recorder import Recording, Sample
+from sim.worldfile import Fault
 
 
 def urdu_result() -> RunResult:
@@ -144,7 +145,8 @@ _REPLAY_JS = """
 
 def replay_result(lang: str = "en") -> RunResult:
     """A report of real simulated runs: two test modules in a room with a wall ahead (the
-    first drives slowly straight into it, at about 9 s), and one among obstacles."""
+    first drives slowly straight into it, at about 9 s; the second's lidar goes silent at
+    4 s), and one among obstacles."""
     from test_render_replay import a_test, recorded
 
     tests = (a_test("test_avoider.py", "test_drives", "The robot drives"),
@@ -153,7 +155,9 @@ def replay_result(lang: str = "en") -> RunResult:
     return RunResult("exercise", "error_handling", "A robust obstacle avoider", tests,
                      lang=lang, data={"recordings": {
                          "test_avoider.py": recorded("wall_ahead", 12, linear=0.1, turn=0.0),
-                         "test_faulty_world.py": recorded("wall_ahead", 8, turn=-0.6),
+                         "test_faulty_world.py": recorded(
+                             "wall_ahead", 8, turn=-0.6,
+                             faults=(Fault(kind="dropout", start=4.0),)),
                          "test_shutdown.py": recorded("obstacles", 12, turn=1.0)}})
 
 
@@ -213,6 +217,7 @@ def test_replay_slider_moves_the_robot_its_scan_and_command(tmp_path: Path) -> N
     # The other run: its own length and pose at the same time.
     assert other["max"] == pytest.approx(8.0)
     assert other["transform"] != halfway["transform"]
+    assert other["dots"] == 0  # its lidar was silent since 4 s: no stale scan is drawn
     # Play moves the time on by itself; the button says what a click will do.
     assert labels[0] == labels[2] != labels[1]
     assert float(played["clock"].split()[0]) > 1.0

@@ -139,7 +139,10 @@ def _replay_data(spec: WorldSpec, recording: Recording,
     scans = recorded.get("scans", [])
     end = max([poses[-1][0]] + [row[0] for row in commands[-1:]]
               + [row[0] for row in scans[-1:]])
-    return {"end": end, "poses": poses,
+    # How far apart the kept scans are: a scan older than 1.5 times that is not drawn, so
+    # a silent lidar (a dropout, or a test feeding scans of its own) shows as none.
+    every = (scans[-1][0] - scans[0][0]) / (len(scans) - 1) if len(scans) > 1 else 0.5
+    return {"end": end, "poses": poses, "scan_every": max(every, 0.5),
             "commands": commands, "scans": scans,
             "scan": recorded.get("scan", {"angle_min": recording.scan_angle_min,
                                           "angle_increment": recording.scan_angle_increment}),

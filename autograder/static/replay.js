@@ -1,6 +1,6 @@
 // The report's replay: in each figure of a world, a slider over simulation time moves the
-// robot, shows its last lidar scan (rays and points) and the command in force, and fades
-// the collisions still to come.  It reads only the figure's own JSON; nothing is fetched.
+// robot, shows its last lidar scan (rays and points; none while the lidar was silent) and
+// the command in force, and fades the collisions still to come.  It reads only the figure's own JSON; nothing is fetched.
 "use strict";
 (() => {
   const SPEED = 2; // sim seconds per wall second while playing
@@ -84,7 +84,7 @@
       arrow.setAttribute("d", commandPath(v, w, radius));
       const s = before(run.scans, t);
       let dots = "", lines = "";
-      if (s >= 0) {
+      if (s >= 0 && t - run.scans[s][0] <= 1.5 * run.scan_every) {
         const [ts, ranges] = run.scans[s];
         const [sx, sy, sa] = poseAt(run.poses, ts);
         ranges.forEach((range, i) => {
