@@ -14,7 +14,7 @@ from __future__ import annotations
 import base64
 import functools
 import hashlib
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -54,7 +54,8 @@ class Run:
     module: str
     labels: tuple[Text, ...]
     collisions: int
-    data: dict[str, Any] | None  # what the replay needs; None without commands and scans
+    data: dict[str, Any] | None  # what the replay needs; None: recorded without commands
+    # and scans (an older results file), drawn as a static picture
 
 
 @dataclass(frozen=True)
@@ -63,7 +64,7 @@ class Figure:
 
     world: Text
     svg: Markup
-    runs: tuple[Run, ...] = field(default_factory=tuple)
+    runs: tuple[Run, ...] = ()
 
     @property
     def collisions(self) -> int:
@@ -71,10 +72,9 @@ class Figure:
 
     @property
     def replay(self) -> list[dict[str, Any]] | None:
-        """The runs' data for the script, or None when no run has any."""
-        if not any(run.data for run in self.runs):
-            return None
-        return [run.data or {"poses": [], "end": 0.0} for run in self.runs]
+        """The runs' data for the script, or None for a static picture."""
+        data = [run.data for run in self.runs if run.data is not None]
+        return data if data and len(data) == len(self.runs) else None
 
 
 @functools.cache
