@@ -267,7 +267,7 @@ class SimBridge:
         """Advance ``steps`` physics steps and publish clock, odometry and scans."""
         cmd, self._cmd = self._cmd, None
         if cmd is not None:
-            self.world.set_command(*cmd)
+            self.sim.set_command(*cmd)
         outputs: list[Outputs] = [self.sim.step() for _ in range(steps)]
         sec, nanosec = _stamp(self.world.time)
         clock = Clock()

@@ -46,7 +46,9 @@ class Simulation:
         self.lidar = lidar or Lidar.from_spec(world.spec.lidar)
         self.odometry = WheelOdometry()
         self.faults = FaultInjector(world.spec.faults, world.seed, self.lidar)
-        self.recording = Recording(world=world.spec.name)
+        self.recording = Recording(world=world.spec.name,
+                                   scan_angle_min=self.lidar.angle_min,
+                                   scan_angle_increment=self.lidar.angle_increment)
         self._odom_every = max(1, round(1.0 / (ODOM_HZ * world.dt)))
         self._scan_every = max(1, round(1.0 / (SCAN_HZ * world.dt)))
 
@@ -70,7 +72,14 @@ class Simulation:
             wheel = Sample(world.time, *self.odometry.pose, self.odometry.v, self.odometry.w)
         if scan_due:
             scan = self.faults.apply(world.time, self.lidar.scan(world))
+            if scan is not None:
+                self.recording.add_scan(scan.t, scan.ranges)
         return Outputs(odom, scan, scan_due, wheel)
+
+    def set_command(self, linear: float, angular: float) -> None:
+        """Drive the robot (body-frame velocities) from now on; the recording keeps it."""
+        self.recording.add_command(self.world.time, linear, angular)
+        self.world.set_command(linear, angular)
 
     def inject(self, fault: Fault) -> None:
         """Add a fault at run time."""

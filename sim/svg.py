@@ -1,4 +1,5 @@
-"""A picture of a run: the arena, walls, obstacles, the path, start, end, goal, collisions.
+"""A picture of a run (or of several in one world): the arena, walls, obstacles, the path,
+start, end, goal, collisions.
 
 A pure function of data returning a self-contained inline SVG (no scripts, no external
 references), so reports can embed it as is.  Its tooltips (the world's title, what each
@@ -9,6 +10,7 @@ everything is drawn inside a group that flips the y axis.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from html import escape
 
 from sim.i18n import _
@@ -29,9 +31,17 @@ def _points(points: list[tuple[float, float]]) -> str:
 
 def trajectory_svg(spec: WorldSpec, recording: Recording, goal: Goal | None = None) -> str:
     """The SVG text for ``recording`` in ``spec``'s arena (``goal`` overrides the spec's)."""
+    return scene_svg(spec, [recording], goal)
+
+
+def scene_svg(spec: WorldSpec, recordings: Sequence[Recording], goal: Goal | None = None,
+              overlay: str = "") -> str:
+    """The SVG text for several runs in one arena: each run's path, end pose and
+    collisions in a group ``<g class="run" data-run="i">``, collisions carrying their time
+    (``data-t``); ``overlay`` is markup drawn on top, in world coordinates (a replay's
+    moving parts)."""
     w, h = spec.size
     goal = goal or spec.goal
-    samples, collisions = recording.snapshot()
     margin = 0.1
     parts = [
         f'<svg xmlns="http://www.w3.org/2000/svg" class="sim-trajectory" '
@@ -57,24 +67,37 @@ def trajectory_svg(spec: WorldSpec, recording: Recording, goal: Goal | None = No
     for circle in spec.obstacles.circles:
         parts.append(f'<circle class="obstacle" cx="{_num(circle.center[0])}" '
                      f'cy="{_num(circle.center[1])}" r="{_num(circle.radius)}" fill="#9e9e9e"/>')
+    start = spec.start
+    parts.append(_robot("start", start.x, start.y, start.theta, "#43a047"))
+    for i, recording in enumerate(recordings):
+        parts += _run(spec, recording, i if len(recordings) > 1 else None)
+    if overlay:
+        parts.append(overlay)
+    parts.append("</g></svg>")
+    return "\n".join(parts)
+
+
+def _run(spec: WorldSpec, recording: Recording, index: int | None) -> list[str]:
+    """One run's path, end pose and collisions (in a group of its own when ``index``)."""
+    samples, collisions = recording.snapshot()
+    parts = [] if index is None else [f'<g class="run" data-run="{index}">']
     if samples:
         path = [(spec.start.x, spec.start.y)] + [(s.x, s.y) for s in samples]
         parts.append(f'<polyline class="path" points="{_points(path)}" fill="none" '
                      f'stroke="#1565c0" stroke-width="0.02" stroke-linejoin="round"/>')
-    start = spec.start
-    parts.append(_robot("start", start.x, start.y, start.theta, "#43a047"))
-    if samples:
         end = samples[-1]
         parts.append(_robot("end", end.x, end.y, end.theta, "#1565c0"))
     for c in collisions:
         d = 0.06
         tooltip = _("{seconds:.2f} s: {what}").format(seconds=c.t, what=describe(c.what))
-        parts.append(f'<path class="collision" d="M{_num(c.x - d)},{_num(c.y - d)} '
+        parts.append(f'<path class="collision" data-t="{_num(c.t)}" '
+                     f'd="M{_num(c.x - d)},{_num(c.y - d)} '
                      f'L{_num(c.x + d)},{_num(c.y + d)} M{_num(c.x - d)},{_num(c.y + d)} '
                      f'L{_num(c.x + d)},{_num(c.y - d)}" stroke="#d32f2f" stroke-width="0.03">'
                      f"<title>{escape(tooltip)}</title></path>")
-    parts.append("</g></svg>")
-    return "\n".join(parts)
+    if index is not None:
+        parts.append("</g>")
+    return parts
 
 
 def _robot(name: str, x: float, y: float, theta: float, colour: str) -> str:

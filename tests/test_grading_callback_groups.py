@@ -16,6 +16,7 @@ from designs import read_design
 from proving import Proof
 
 from autograder.core.exercise import find_exercise
+from autograder.render.html import to_html
 
 pytestmark = pytest.mark.slow
 
@@ -80,3 +81,15 @@ def test_old_scan_is_told_why(graded):
     by_name = {t.name: t for t in result.tests}
     assert "before any scan newer than the request existed" in \
         by_name["test_answer_uses_newer_scan"].message
+
+
+def test_report_plots_the_scan_rate_reports(graded):
+    """The rate tests attach the intervals of scans_per_second they read (about 1 s)."""
+    result = graded["reference#0"]
+    charts = {t.name: t.data["charts"] for t in result.tests}
+    for name in ("test_scan_rate", "test_concurrent_requests", "test_never_deadlocks"):
+        (chart,) = charts[name]
+        assert chart["title"] == "scans_per_second" and chart["points"], name
+        assert all(0.5 <= gap <= 1.5 for _t, gap in chart["points"]), (name, chart)
+    page = to_html(result, find_exercise("callback_groups").folder)
+    assert page.count('class="chart"') == 3

@@ -9,11 +9,14 @@ loses exactly the tests its expect.yaml names.  Gradings run seven at a time.
 
 from __future__ import annotations
 
+import re
+
 import pytest
 from designs import read_design
 from proving import Proof, without_both_types
 
 from autograder.core.exercise import find_exercise
+from autograder.render.html import to_html
 
 pytestmark = pytest.mark.slow
 
@@ -69,3 +72,23 @@ def test_a_twist_stamped_node_is_told_both_types(graded):
     """The reference solution publishing TwistStamped, as for Jazzy's TurtleBot3: every test
     it loses says what it sent and what this exercise's robot takes."""
     assert without_both_types(graded["twist_stamped"]) == {}
+
+
+def test_report_plots_the_intervals_each_rate_test_measured(graded):
+    """The report shows the message-interval plots README promises for rate tests, and
+    the robot's runs in the long hall as one replayable picture."""
+    result = graded["reference#0"]
+    charts = {t.name: t.data["charts"] for t in result.tests}
+    (control,) = charts["test_control_rate"]
+    assert control["title"] == "cmd_vel"
+    assert control["limit"] == pytest.approx(0.15)  # the largest gap allowed
+    assert len(control["points"]) > 250  # 30 s at 10 Hz
+    assert all(gap <= control["limit"] for _t, gap in control["points"])  # the reference keeps it
+    assert len(charts["test_control_while_planning"]) >= 2  # one per planner run
+    for name in ("test_status_rate", "test_plan_rate", "test_rates_at_half_speed"):
+        assert [len(c["points"]) > 0 for c in charts[name]] == [True], name
+    page = to_html(result, find_exercise("timer_sync").folder)
+    assert page.count('<svg xmlns="http://www.w3.org/2000/svg" class="chart"') == sum(
+        len(c) for c in charts.values())
+    (hall,) = re.findall(r'<figure class="world">.*?</figure>', page, re.S)
+    assert "test_controller.py" in hall and 'class="replay-data"' in hall

@@ -128,6 +128,8 @@ def test_cmd_vel_moves_robot(graph: tuple[SimBridge, Probe]) -> None:
     assert bridge.wait_for(lambda: probe.odom[-1][1] > odom_x0 + 0.3, sim_timeout=1.0,
                            wall_timeout=WALL)
     assert math.isclose(bridge.world.velocity[0], 0.5, abs_tol=1e-3)
+    # The recording keeps the command, for the report's replay.
+    assert (0.5, 0.0) in [(c.linear, c.angular) for c in bridge.recording.commands]
     probe.cmd.publish(Twist())
 
 

@@ -222,7 +222,9 @@ def result_of(raw: RawTest, status: str | None = None,
         max_score=max_score, status=status,  # type: ignore[arg-type]
         message=raw.message if message is None else message, hint=raw.hint,
         visibility=raw.visibility, reveal=raw.reveal,  # type: ignore[arg-type]
-        details=raw.details, data={"charts": raw.charts, "nodeid": raw.nodeid})
+        details=raw.details,
+        # The test module names the world's recording it ran in (report pictures).
+        data={"charts": raw.charts, "nodeid": raw.nodeid, "module": _module_of(raw.nodeid)})
 
 
 def _score(status: str, max_score: Fraction, fraction: float | None) -> Fraction:
@@ -245,6 +247,12 @@ def _forged(exercise: Exercise, elapsed: float) -> RunResult:
     return RunResult(kind="exercise", id=exercise.id, title=exercise.localized_title,
                      tests=(test,), pass_mark=exercise.pass_fraction, lang=get_language(),
                      execution_time=elapsed, data={"forged": True})
+
+
+def _module_of(nodeid: str) -> str:
+    """The test module's file name, as the world's recordings are keyed
+    ("tests/public/test_governor.py::test_clamps" -> "test_governor.py")."""
+    return nodeid.partition("::")[0].rpartition("/")[2]
 
 
 def _result(exercise: Exercise, raw_report: RawReport, returncode: int | None,

@@ -44,7 +44,7 @@ def test_ignores_invalid_readings(student, probe, scans, world, alive):
 
 
 @pytest.mark.points(2)
-def test_concurrent_requests(student, probe, scans, rates, alive):
+def test_concurrent_requests(student, probe, scans, rates, alive, evidence):
     """Five requests at once are all answered within 1.0 s, and scans keep being counted"""
     require_alive(alive)
     requests = Requests(probe)
@@ -68,6 +68,8 @@ def test_concurrent_requests(student, probe, scans, rates, alive):
                   _("Among five requests sent together"))
         probe.wait_for(lambda: probe.now > start + 2.5, 4.0)
         reports = rate_reports(rates, start + 0.5, start + 2.5)
+        evidence.intervals("scans_per_second",
+                           [t for t in rates.times if start <= t <= start + 2.5])
         if len(reports) < 2 or not all(RATE_LOW <= v <= RATE_HIGH for v in reports):
             raise StudentFailure(
                 _("While requests were served, scans_per_second read {values}; expected "
@@ -162,12 +164,14 @@ def test_answer_uses_newer_scan(student, probe, scans, world, alive):
 
 
 @pytest.mark.points(1)
-def test_never_deadlocks(student, probe, rates, alive):
+def test_never_deadlocks(student, probe, rates, alive, evidence):
     """After all that, the node still counts scans and answers"""
     require_alive(alive)
     start = probe.now
     probe.wait_for(lambda: probe.now > start + 2.2, 3.0)
     reports = rate_reports(rates, start + 0.1, start + 2.2)
+    evidence.intervals("scans_per_second",
+                       [t for t in rates.times if start <= t <= start + 2.2])
     if len(reports) < 2 or not all(RATE_LOW <= v <= RATE_HIGH for v in reports):
         raise StudentFailure(
             _("At the end, scans_per_second read {values} in 2 s of simulation time; expected "

@@ -44,13 +44,14 @@ def test_node_starts(student, probe, scans, rates):
 
 
 @pytest.mark.points(1)
-def test_scan_rate(student, probe, scans, rates, alive):
+def test_scan_rate(student, probe, scans, rates, alive, evidence):
     """scans_per_second reports about 10 scans per second"""
     require_alive(alive)
     start = probe.now
     probe.wait_for(lambda: sum(1 for t in rates.times if t > start) >= 4, 6.0)
     came = [m.data for t, m in rates.items if t > start]
     values = came[1:]  # the first may be partial
+    evidence.intervals("scans_per_second", [t for t in rates.times if t > start])
     if len(values) < 3:
         raise StudentFailure(
             ngettext("scans_per_second came {count} time in {seconds:.1f} s of simulation "

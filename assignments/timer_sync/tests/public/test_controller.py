@@ -44,10 +44,11 @@ def test_node_starts(student, probe, streams):
 
 
 @pytest.mark.points(3)
-def test_control_rate(run):
+def test_control_rate(run, evidence):
     """cmd_vel keeps 10 Hz for 30 s of simulation time, with no gap over 0.15 s"""
     require_commands(run)
     times = run.command_times()
+    evidence.intervals("cmd_vel", times, MAX_GAP)
     seconds = run.end - run.start
     gap, where = biggest_gap(times, run.start, run.end)
     if run.frozen_at is not None:
@@ -76,7 +77,7 @@ def test_control_rate(run):
 
 
 @pytest.mark.points(2)
-def test_control_while_planning(run):
+def test_control_while_planning(run, evidence):
     """cmd_vel keeps 10 Hz while the planner runs"""
     require_commands(run)
     plans = run.plan_times()
@@ -90,6 +91,7 @@ def test_control_while_planning(run):
     for done in plans:
         began = max(run.start, done - PLAN_SECONDS)
         times = run.command_times(began, done)
+        evidence.intervals("cmd_vel", times, MAX_GAP)  # one plot per planner run
         gap, where = biggest_gap(times, began, done)
         if gap > MAX_GAP or not rate_ok(len(times), done - began, CONTROL_HZ):
             raise StudentFailure(
@@ -101,7 +103,7 @@ def test_control_while_planning(run):
 
 
 @pytest.mark.points(1)
-def test_status_rate(run):
+def test_status_rate(run, evidence):
     """status comes at 1 Hz as a JSON object with integer control_ticks and plans"""
     require_commands(run)
     items = run.status_items()
@@ -120,6 +122,7 @@ def test_status_rate(run):
             _("Build a dict and publish json.dumps(it) as the String's data."))
     require_not_frozen(run, _("the status rate"))
     times = [t for t, _m in items]
+    evidence.intervals("status", times, STATUS_PERIOD + 0.1)
     gap, where = biggest_gap(times, run.start, run.end)
     if not rate_ok(len(items), seconds, 1.0 / STATUS_PERIOD) or gap > STATUS_PERIOD + 0.1 + 1e-6:
         raise StudentFailure(
@@ -205,11 +208,12 @@ def _ticks_hint(items: list[tuple[float, dict[str, int]]], command_times: list[f
 
 
 @pytest.mark.points(2)
-def test_plan_rate(run):
+def test_plan_rate(run, evidence):
     """A plan is published every 10 s of simulation time"""
     require_commands(run)
     plans = run.plan_times()
     seconds = run.end - run.start
+    evidence.intervals("plan", plans, PLAN_PERIOD + 0.25)
     if len(plans) < 2:
         counted = max((s["plans"] for s in map(parse_status, (m for _t, m in run.statuses))
                        if s is not None), default=0)
@@ -243,12 +247,13 @@ def test_plan_rate(run):
 
 
 @pytest.mark.points(2)
-def test_rates_at_half_speed(run):
+def test_rates_at_half_speed(run, evidence):
     """Rates hold in simulation time when the world runs at half speed"""
     require_commands(run)
     require_not_frozen(run, _("the rates at half speed"))
     seconds = run.end - run.switch
     commands = run.command_times(run.switch, run.end)
+    evidence.intervals("cmd_vel", commands)  # the rates are judged here, not the gaps
     statuses = [t for t, _m in run.status_items() if t >= run.switch]
     if not rate_ok(len(commands), seconds, CONTROL_HZ) or \
             not rate_ok(len(statuses), seconds, 1.0 / STATUS_PERIOD):
