@@ -40,10 +40,18 @@ def test_an_exercises_own_world_file_is_given_by_path() -> None:
     assert world.is_file() and world.name == "supervisor_room.yaml"
 
 
-def test_exercise_goes_with_node() -> None:
-    result = CliRunner().invoke(main, ["sim", "run", "--exercise", "timer_sync"])
+def test_exercise_and_params_go_with_node() -> None:
+    for option in (["--exercise", "timer_sync"], ["--param", "goal_x:=1.0"]):
+        result = CliRunner().invoke(main, ["sim", "run", *option])
+        assert result.exit_code == 2
+        assert "--exercise and --param go with --node FILE" in result.output
+
+
+def test_a_param_must_read_name_value() -> None:
+    node = str(NODES / "steady_driver.py")
+    result = CliRunner().invoke(main, ["sim", "run", "--node", node, "-p", "goal_x=1.0"])
     assert result.exit_code == 2
-    assert "--exercise goes with --node" in result.output
+    assert "'goal_x=1.0' is not NAME:=VALUE" in result.output
 
 
 def test_a_syntax_error_is_said_before_the_world_starts(tmp_path: Path) -> None:
@@ -108,12 +116,14 @@ def _read_until(stream, pattern: re.Pattern[str], wall: float) -> tuple[str, re.
 
 @pytest.mark.slow
 def test_ctrl_c_stops_world_and_node_and_leaves_nothing(ros_domain: int) -> None:
-    run = subprocess.Popen(_command(ros_domain, "--node", str(NODES / "steady_driver.py")),
+    run = subprocess.Popen(_command(ros_domain, "--node", str(NODES / "steady_driver.py"),
+                                    "--param", "speed:=0.2"),
                            env=_env(), stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                            text=True)
     try:
         seen, found = _read_until(run.stdout, FIRST, WALL)
         assert found, seen
+        assert "speed 0.2" in seen  # --param reached the node as -p speed:=0.2
         run.send_signal(signal.SIGINT)  # as Ctrl-C in its terminal
         rest, _ = run.communicate(timeout=WALL)
     finally:

@@ -64,6 +64,7 @@ class NodeRun:
     script: Path
     exercise: Exercise | None = None
     echo: Callable[[bytes], None] | None = None
+    params: tuple[str, ...] = ()  # "name:=value", as given to --ros-args -p
     process: StudentProcess | None = None
     _folder: Path | None = None
     _bridge: SimBridge | None = None
@@ -87,7 +88,10 @@ class NodeRun:
         name = self.exercise.file if self.exercise is not None else self.script.name
         staged = stage(self.script, name, self._folder / "staged")
         course = self.exercise.folder.parent.parent if self.exercise else self._folder
-        self.process = student_process(staged, ["-p", "use_sim_time:=true"], self._limits(),
+        args = ["-p", "use_sim_time:=true"]
+        for param in self.params:
+            args += ["-p", param]
+        self.process = student_process(staged, args, self._limits(),
                                        domain=bridge.node.context.get_domain_id(),
                                        strict=False, course=course)
         self.process.echo = self.echo
@@ -192,6 +196,17 @@ def _stdout_writer() -> Callable[[bytes], None]:
     return write
 
 
+def _check_params(ctx: click.Context, param: click.Parameter,
+                  values: tuple[str, ...]) -> tuple[str, ...]:
+    """Each ``--param`` must read ``name:=value``, as ``--ros-args -p`` takes it."""
+    for value in values:
+        name, sep, _rest = value.partition(":=")
+        if not sep or not name.strip():
+            raise click.BadParameter(_("{value!r} is not NAME:=VALUE, e.g. goal_x:=1.5").format(
+                value=value), ctx=ctx, param=param)
+    return values
+
+
 def add_node_options(run: click.Command) -> None:
     """Give ``sim run`` (``run``) the options ``--node FILE`` and ``--exercise ID``."""
     if any(param.name == "node_file" for param in run.params):
@@ -201,6 +216,10 @@ def add_node_options(run: click.Command) -> None:
                      type=click.Path(exists=True, dir_okay=False, path_type=Path),
                      help="Start this node file with the world, as grading starts it; "
                           "simulation time starts once its node is up."),
+        click.Option(["--param", "-p", "params"], multiple=True, metavar="NAME:=VALUE",
+                     callback=_check_params,
+                     help="A ROS parameter for the node (repeatable), as "
+                          "'--ros-args -p NAME:=VALUE' gives it."),
         click.Option(["--exercise"], default=None,
                      help="The exercise the node file is for (default: the one whose file "
                           "has its name); picks the exercise's world and pacing."),
@@ -214,11 +233,12 @@ def add_node_options(run: click.Command) -> None:
     assert original is not None
 
     @functools.wraps(original)
-    def callback(node_file: Path | None, exercise: str | None, **kwargs: Any) -> Any:
+    def callback(node_file: Path | None, exercise: str | None, params: tuple[str, ...],
+                 **kwargs: Any) -> Any:
         ctx = click.get_current_context()
         if node_file is None:
-            if exercise is not None:
-                raise click.UsageError(_("--exercise goes with --node FILE."))
+            if exercise is not None or params:
+                raise click.UsageError(_("--exercise and --param go with --node FILE."))
             return original(**kwargs)
         _check_syntax(node_file)  # before the world: nothing to watch
         found = node_exercise(node_file, exercise)
@@ -229,7 +249,7 @@ def add_node_options(run: click.Command) -> None:
                 kwargs["world_name"] = exercise_world(found)
             if ctx.get_parameter_source("clock_hz") is ParameterSource.DEFAULT:
                 kwargs["clock_hz"] = found.clock_hz
-        ctx.meta[COMPANION] = NodeRun(node_file, found, echo=_stdout_writer())
+        ctx.meta[COMPANION] = NodeRun(node_file, found, echo=_stdout_writer(), params=params)
         return original(**kwargs)
 
     run.callback = callback
