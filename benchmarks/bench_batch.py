@@ -18,7 +18,7 @@ from pathlib import Path
 
 from autograder.core.exercise import Exercise, find_exercise, list_exercises
 
-CHOSEN = re.compile(r"--jobs auto: (\d+) grading")
+CHOSEN = re.compile(r"--jobs auto: (\d+) grading.*")
 
 
 def run(exercise: Exercise, copies: int, jobs: str, workdir: Path) -> dict[str, str]:
@@ -41,7 +41,8 @@ def run(exercise: Exercise, copies: int, jobs: str, workdir: Path) -> dict[str, 
     return {"exercise": exercise.id, "jobs": jobs + (f" ({chosen[1]})" if chosen else ""),
             "wall s": f"{wall:.1f}", "s/student": f"{wall / copies:.1f}",
             "students/h": f"{3600 * copies / wall:.0f}",
-            "all full": "yes" if full else f"NO ({proc.returncode})"}
+            "all full": "yes" if full else f"NO ({proc.returncode})",
+            "said": chosen[0] if chosen else ""}
 
 
 def main() -> None:
@@ -58,6 +59,8 @@ def main() -> None:
             for jobs in args.jobs.split(","):
                 row = run(exercise, args.students, jobs, Path(tmp))
                 print(" | ".join(row[c] for c in columns), flush=True)
+                if row["said"]:
+                    print(f"  {row['said']}", flush=True)
 
 
 if __name__ == "__main__":
