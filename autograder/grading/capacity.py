@@ -22,8 +22,8 @@ from autograder.i18n import _, ngettext
 # Fraction of the cores the gradings may keep busy together: the rest is headroom for the
 # pacing (it ticks when the student's process is idle) and for bursts such as start-up.
 TARGET_LOAD = 0.75
-# Most gradings at once: the highest concurrency the proofs have checked gives the same
-# verdicts as one by one (README "A whole class").
+# Most gradings at once: the highest concurrency measured to keep every score full
+# (README "A whole class", benchmarks/bench_batch.py).
 MAX_JOBS = 8
 # Resident memory of one grading (pytest child, simulator, student node), measured ~250 MB;
 # rounded up so a node that allocates more still fits.
@@ -80,8 +80,8 @@ def describe(choice: Choice) -> str:
         why = _("Every student left to grade at once (the first grading used {share} of a "
                 "core, on {cores} cores).").format(share=share, cores=cores)
     else:
-        why = _("At most {ceiling}, the most checked to give the same scores as one by one "
-                "(the first grading used {share} of a core, on {cores} cores).").format(
+        why = _("At most {ceiling}, the most measured to keep every score (the first "
+                "grading used {share} of a core, on {cores} cores).").format(
             ceiling=choice.jobs, share=share, cores=cores)
     return f"{head} {why}"
 
