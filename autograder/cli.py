@@ -271,11 +271,31 @@ def bundle_gradescope(exercise: str, zip_path: Path) -> None:
     click.echo(_("Gradescope autograder written to {path}").format(path=zip_path))
 
 
+class _JobsType(click.ParamType):
+    """``--jobs``: a number of gradings at once (1 to 64), or ``auto``."""
+
+    name = "N|auto"
+
+    def convert(self, value, param, ctx):  # noqa: ANN001, ANN201
+        if isinstance(value, int) or value == "auto":
+            return value
+        try:
+            jobs = int(value)
+        except ValueError:
+            jobs = 0
+        if not 1 <= jobs <= 64:
+            self.fail(_("--jobs must be a number from 1 to 64 or auto, got {value}").format(
+                value=value), param, ctx)
+        return jobs
+
+
 @main.command("grade-batch")
 @click.argument("item", metavar="EXERCISE_OR_QUIZ")
 @click.argument("submissions", type=click.Path(path_type=Path, file_okay=False, exists=True))
-@click.option("--jobs", type=click.IntRange(1, 64), default=1, show_default=True,
-              help="Gradings run at the same time (each on its own ROS domain).")
+@click.option("--jobs", type=_JobsType(), default="1", show_default=True,
+              help="Gradings run at the same time (each on its own ROS domain), or 'auto': "
+                   "grade the first student alone and choose from its CPU use and the "
+                   "machine's cores and memory.")
 @click.option("--csv", "csv_path", type=click.Path(path_type=Path, dir_okay=False),
               required=True, help="The gradebook CSV (merged into if it exists).")
 @click.option("--out", type=click.Path(path_type=Path, file_okay=False), default=None,
@@ -285,7 +305,7 @@ def bundle_gradescope(exercise: str, zip_path: Path) -> None:
 @click.option("--record", type=click.Path(path_type=Path, file_okay=False), default=None,
               help="Record each student's grading as rosbag2 bags (MCAP) in RECORD/<student>.")
 @_lang_option
-def grade_batch(item: str, submissions: Path, jobs: int, csv_path: Path, out: Path | None,
+def grade_batch(item: str, submissions: Path, jobs: int | str, csv_path: Path, out: Path | None,
                 shard: str | None, record: Path | None) -> None:
     """Grade every submission in SUBMISSIONS (one sub-folder or file per student), or score
     every answers file for a quiz. Resumable: graded students are skipped."""
@@ -305,6 +325,10 @@ def grade_batch(item: str, submissions: Path, jobs: int, csv_path: Path, out: Pa
         else:
             click.echo(f"{student}: {result.score}/{result.max_score}", err=True)
 
+    if jobs == "auto":
+        from autograder.grading.capacity import auto_chooser
+
+        jobs = auto_chooser(lambda line: click.echo(line, err=True))
     rows = run_batch(students(submissions, suffix), grade_one, out, csv_path, jobs=jobs,
                      shard=share, extra=extra, progress=progress)
     click.echo(ngettext("{count} row in {path}", "{count} rows in {path}", len(rows)).format(

@@ -106,6 +106,16 @@ def test_batch_with_two_jobs_matches_one_by_one(tmp_path, submissions, one_by_on
     assert "RuntimeError: boom" in (out / "student04" / "output.log").read_text()  # crash
 
 
+def test_batch_at_auto_matches_one_by_one(tmp_path, submissions, one_by_one, course_env):
+    book = tmp_path / "gradebook.csv"
+    proc = batch(["shout", str(submissions), "--jobs", "auto", "--csv", str(book),
+                  "--out", str(tmp_path / "reports")], course_env)
+    output, _ = proc.communicate(timeout=600)
+    assert proc.returncode == 0, output
+    assert re.search(r"--jobs auto: \d+ gradings? at a time\. ", output), output
+    assert {s: r["score"] for s, r in rows(book).items()} == one_by_one
+
+
 def _processes() -> dict[int, tuple[int, str]]:
     """Every process: pid -> (parent pid, start time), from /proc."""
     found = {}

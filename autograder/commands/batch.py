@@ -5,6 +5,8 @@ soon as they are graded, atomically; running the batch again skips every student
 results are there, so a crash halfway loses nothing already graded.  ``--shard I/N``
 grades a stable share: a student's shard is a hash of their name, so it never moves when
 others are added.  Parallel gradings each hold their own ROS domain: no cross-talk.
+``jobs`` may be a chooser (``--jobs auto``): the first student is graded alone, measured,
+and the chooser picks the concurrency for the rest (:mod:`autograder.grading.capacity`).
 """
 
 from __future__ import annotations
@@ -18,6 +20,10 @@ from pathlib import Path
 
 from autograder.commands import gradebook
 from autograder.core.results import RunResult
+from autograder.grading.capacity import measured
+
+# Given the first grading's CPU share (cores) and the students left, how many at once.
+Chooser = Callable[[float, int], int]
 
 
 def students(folder: Path, suffix: str | None = None) -> dict[str, Path]:
@@ -67,28 +73,39 @@ def _save(out: Path, student: str, result: RunResult,
 
 
 def run_batch(entries: dict[str, Path], grade_one: Callable[[Path], RunResult], out: Path,
-              csv_path: Path, *, jobs: int = 1, shard: tuple[int, int] | None = None,
+              csv_path: Path, *, jobs: int | Chooser = 1, shard: tuple[int, int] | None = None,
               extra: Callable[[RunResult, Path], None] | None = None,
               progress: Callable[[str, RunResult | None], None] | None = None,
               ) -> list[gradebook.Row]:
-    """Grade every entry in this shard that has no results yet; write the gradebook."""
+    """Grade every entry in this shard that has no results yet; write the gradebook.
+
+    With a chooser for ``jobs``, the first student to grade is graded alone and measured
+    and the chooser sets the concurrency for the others."""
     mine = {s: p for s, p in entries.items() if in_shard(s, shard)}
     todo = {s: p for s, p in mine.items() if not _results_path(out, s).exists()}
     lock = threading.Lock()
 
-    def work(student: str, path: Path) -> None:
-        result = grade_one(path)
+    def work(student: str, path: Path, first: bool = False) -> float:
+        result, share = measured(lambda: grade_one(path)) if first else (grade_one(path), 0.)
         _save(out, student, result, extra)
         with lock:
             _write_gradebook(out, mine, csv_path)
             if progress:
                 progress(student, result)
+        return share
 
     for student in sorted(set(mine) - set(todo)):
         if progress:
             progress(student, None)
+    queue = sorted(todo.items())
+    if callable(jobs):
+        if len(queue) > 1:
+            share = work(*queue.pop(0), first=True)
+            jobs = jobs(share, len(queue))
+        else:
+            jobs = 1
     with ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
-        for future in [pool.submit(work, s, p) for s, p in sorted(todo.items())]:
+        for future in [pool.submit(work, s, p) for s, p in queue]:
             future.result()
     return _write_gradebook(out, mine, csv_path)
 

@@ -1,0 +1,67 @@
+"""Batch throughput: N copies of an exercise's reference graded by `grade-batch` at each
+--jobs, in wall seconds and students per hour, and whether every score was full (the batch
+must never change a verdict).  Heavy: run it under `flock /tmp/agheavy.lock`.
+
+    python benchmarks/bench_batch.py [--students 8] [--jobs 1,2,4,8,auto] [--exercise EX ...]
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import re
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from autograder.core.exercise import Exercise, find_exercise, list_exercises
+
+CHOSEN = re.compile(r"--jobs auto: (\d+) grading.*")
+
+
+def run(exercise: Exercise, copies: int, jobs: str, workdir: Path) -> dict[str, str]:
+    """One batch of ``copies`` references at ``jobs``: its row of the table."""
+    folder = workdir / f"{exercise.id}-{jobs}"
+    for i in range(copies):
+        (folder / "submissions" / f"student{i:02d}").mkdir(parents=True)
+        (folder / "submissions" / f"student{i:02d}" / exercise.file).write_bytes(
+            exercise.solution.read_bytes())
+    book = folder / "gradebook.csv"
+    began = time.monotonic()
+    proc = subprocess.run([sys.executable, "-m", "autograder.cli", "grade-batch", exercise.id,
+                           str(folder / "submissions"), "--jobs", jobs, "--csv", str(book),
+                           "--out", str(folder / "out")], capture_output=True, text=True)
+    wall = time.monotonic() - began
+    with book.open(encoding="utf-8") as fh:
+        rows = list(csv.DictReader(fh)) if proc.returncode == 0 else []
+    full = len(rows) == copies and all(r["score"] == r["max_score"] for r in rows)
+    chosen = CHOSEN.search(proc.stderr)
+    return {"exercise": exercise.id, "jobs": jobs + (f" ({chosen[1]})" if chosen else ""),
+            "wall s": f"{wall:.1f}", "s/student": f"{wall / copies:.1f}",
+            "students/h": f"{3600 * copies / wall:.0f}",
+            "all full": "yes" if full else f"NO ({proc.returncode})",
+            "said": chosen[0] if chosen else ""}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--students", type=int, default=8)
+    parser.add_argument("--jobs", default="1,2,4,8,auto")
+    parser.add_argument("--exercise", action="append", default=[])
+    args = parser.parse_args()
+    exercises = [find_exercise(e) for e in args.exercise] or list_exercises()
+    columns = ["exercise", "jobs", "wall s", "s/student", "students/h", "all full"]
+    print(" | ".join(columns), flush=True)
+    with tempfile.TemporaryDirectory(prefix="bench-batch-") as tmp:
+        for exercise in exercises:
+            for jobs in args.jobs.split(","):
+                row = run(exercise, args.students, jobs, Path(tmp))
+                print(" | ".join(row[c] for c in columns), flush=True)
+                if row["said"]:
+                    print(f"  {row['said']}", flush=True)
+
+
+if __name__ == "__main__":
+    main()

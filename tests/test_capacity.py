@@ -1,0 +1,132 @@
+"""--jobs auto: the concurrency chosen from the machine and one grading's CPU share, the
+cgroup files it reads, and the batch grading its first student alone to measure it."""
+
+from __future__ import annotations
+
+import json
+from fractions import Fraction
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from autograder.cli import main
+from autograder.commands.batch import run_batch
+from autograder.core.results import RunResult, TestResult
+from autograder.grading import capacity
+from autograder.grading.capacity import Choice, choose_jobs, describe
+
+MACHINE = {"cores": 2.0, "memory_mb": 8000.0, "grading_mb": 400.0}
+
+
+@pytest.mark.parametrize(("share", "students", "memory", "jobs", "bound"), [
+    (0.2, 20, 8000.0, 7, "cpu"),        # clock-bound: several per core
+    (1.0, 20, 8000.0, 1, "cpu"),        # CPU-bound: one core each, headroom kept
+    (0.5, 20, 8000.0, 3, "cpu"),
+    (0.2, 3, 8000.0, 3, "students"),    # no more than there are students
+    (0.2, 20, 1000.0, 2, "memory"),     # 1000 MB at 400 MB each
+    (0.01, 20, 8000.0, 8, "ceiling"),   # a grading that hardly computes: the checked most
+    (3.0, 20, 100.0, 1, "cpu"),         # nothing fits: still one
+], ids=["clock-bound", "cpu-bound", "half-core", "few-students", "low-memory", "ceiling",
+        "never-zero"])
+def test_choose_jobs(share, students, memory, jobs, bound) -> None:
+    choice = choose_jobs(**{**MACHINE, "memory_mb": memory}, cpu_share=share,
+                         students=students)
+    assert (choice.jobs, choice.bound) == (jobs, bound)
+
+
+def test_a_first_grading_that_only_hangs_is_not_believed_to_cost_nothing() -> None:
+    choice = choose_jobs(cores=2, memory_mb=1e6, grading_mb=400, cpu_share=0.0,
+                         students=100, ceiling=100)
+    assert choice.cpu_share == capacity.MIN_SHARE and choice.jobs == 10
+
+
+@pytest.mark.parametrize("bound", ["cpu", "memory", "students", "ceiling"])
+def test_describe_says_the_number_and_why(bound) -> None:
+    line = describe(Choice(3, bound, 2.0, 0.25, 1200.0, 400.0))
+    assert line.startswith("--jobs auto: 3 gradings at a time.")
+    assert {"cpu": "0.25 of a core, on 2 cores", "memory": "1200 MB free",
+            "students": "Every student", "ceiling": "At most 3"}[bound] in line
+    assert "grading at a time." in describe(Choice(1, "cpu", 2.0, 1.0, 1200.0, 400.0))
+
+
+def _write(root: Path, files: dict[str, str]) -> Path:
+    for name, text in files.items():
+        (root / name).parent.mkdir(parents=True, exist_ok=True)
+        (root / name).write_text(text + "\n")
+    return root
+
+
+@pytest.mark.parametrize(("files", "cpus"), [
+    ({"cpu.max": "150000 100000"}, 1.5),
+    ({"cpu.max": "max 100000"}, None),
+    ({"cpu/cpu.cfs_quota_us": "50000", "cpu/cpu.cfs_period_us": "100000"}, 0.5),
+    ({"cpu/cpu.cfs_quota_us": "-1", "cpu/cpu.cfs_period_us": "100000"}, None),
+    ({}, None),
+], ids=["v2", "v2-unlimited", "v1", "v1-unlimited", "none"])
+def test_cgroup_cpu_quota(tmp_path, files, cpus) -> None:
+    assert capacity.cgroup_cpus(_write(tmp_path, files)) == cpus
+
+
+@pytest.mark.parametrize(("files", "free"), [
+    ({"memory.max": str(2 << 30), "memory.current": str(1 << 30)}, 1024.0),
+    ({"memory.max": "max", "memory.current": "5"}, None),
+    ({"memory/memory.limit_in_bytes": str(3 << 30),
+      "memory/memory.usage_in_bytes": str(1 << 30)}, 2048.0),
+    ({"memory/memory.limit_in_bytes": str(1 << 62),
+      "memory/memory.usage_in_bytes": "5"}, None),
+], ids=["v2", "v2-unlimited", "v1", "v1-unlimited"])
+def test_cgroup_free_memory(tmp_path, files, free) -> None:
+    assert capacity.cgroup_free_mb(_write(tmp_path, files)) == free
+
+
+def test_machine_cores_takes_the_lesser_of_affinity_and_quota(tmp_path) -> None:
+    assert capacity.machine_cores(_write(tmp_path, {"cpu.max": "50000 100000"})) == 0.5
+    assert capacity.machine_cores(tmp_path / "none") >= 1
+
+
+def test_available_memory_from_meminfo(tmp_path) -> None:
+    meminfo = _write(tmp_path, {"meminfo": "MemTotal: 100 kB\nMemAvailable:    2048 kB"})
+    assert capacity.available_mb(meminfo / "meminfo") == 2.0
+    assert capacity.available_mb(tmp_path / "missing") is None
+
+
+def _result(score: int) -> RunResult:
+    test = TestResult(name="t", label="t", score=Fraction(score), max_score=Fraction(3),
+                      status="passed" if score == 3 else "failed")
+    return RunResult(kind="exercise", id="ex", title="Ex", tests=(test,))
+
+
+def test_auto_grades_the_first_alone_then_as_many_as_chosen(tmp_path) -> None:
+    entries = {f"s{i}": tmp_path / f"s{i}" for i in range(5)}
+    asked = []
+
+    def grade_one(path: Path) -> RunResult:
+        return _result(3)
+
+    def chooser(share: float, students: int) -> int:
+        asked.append((share >= 0, students, len(list((tmp_path / "out").iterdir()))))
+        return 2
+
+    rows = run_batch(entries, grade_one, tmp_path / "out", tmp_path / "book.csv",
+                     jobs=chooser)
+    assert asked == [(True, 4, 1)]  # after the first student, for the four left
+    assert len(rows) == 5 and {r["score"] for r in rows} == {"3"}
+    assert json.loads((tmp_path / "out/s0/results.json").read_text())["score"] == 3
+
+
+def test_auto_with_one_student_left_chooses_nothing(tmp_path) -> None:
+    def chooser(share: float, students: int) -> int:
+        raise AssertionError("not asked")
+
+    rows = run_batch({"only": tmp_path / "only"}, lambda p: _result(2), tmp_path / "out",
+                     tmp_path / "book.csv", jobs=chooser)
+    assert [r["score"] for r in rows] == ["2"]
+
+
+@pytest.mark.parametrize("value", ["0", "65", "many"])
+def test_cli_rejects_jobs_that_are_not_a_number_or_auto(tmp_path, value) -> None:
+    result = CliRunner().invoke(main, ["grade-batch", "x", str(tmp_path), "--jobs", value,
+                                       "--csv", str(tmp_path / "b.csv")])
+    assert result.exit_code == 2
+    assert "--jobs must be a number from 1 to 64 or auto" in result.output
