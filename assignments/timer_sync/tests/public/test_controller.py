@@ -147,6 +147,8 @@ def test_status_counts(run):
     if len(items) < 3:
         invalid = [m.data for _t, m, s in parsed if s is None]
         raise StudentFailure(
+            _("No valid status message came; at least 3 are needed to compare counts.")
+            if not items else
             ngettext("Only {count} valid status message came; at least 3 are needed to "
                      "compare counts.",
                      "Only {count} valid status messages came; at least 3 are needed to "
