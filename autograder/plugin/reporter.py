@@ -169,10 +169,9 @@ class GradingReporter:
 def peak_memory() -> dict[str, float]:
     """Peak resident memory in MB: this process (pytest, the world and the probe) and the
     largest student process it has waited for (each started program is, when stopped)."""
-    grader = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024  # KB on Linux
-    student = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
-    return {"grader_mb": round(grader, 1), "student_mb": round(student, 1),
-            "total_mb": round(grader + student, 1)}
+    grader = round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, 1)  # KB
+    student = round(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024, 1)
+    return {"grader_mb": grader, "student_mb": student, "total_mb": round(grader + student, 1)}
 
 
 def _points(item: pytest.Item) -> Any:
