@@ -1,6 +1,8 @@
 """Grading speed: wall time to grade each exercise's reference solution, the time from
 the student's process start to its node being seen on the graph, and how the world's
-ticks went on (student idle, CPU share used, wall cap hit: see sim/bridge.py).
+ticks went on (student idle, CPU share used, wall cap hit: see sim/bridge.py); then where
+the seconds went (the results file's ``timing``, summed over test modules, median over
+the runs) and the peak memory of a grading (``memory``, the largest over the runs).
 
     python benchmarks/bench_grading.py [--runs 5] [EXERCISE ...]
 """
@@ -11,9 +13,13 @@ import argparse
 import collections
 import statistics
 import time
+from typing import Any
 
 from autograder.core.exercise import find_exercise, list_exercises
 from autograder.grading.run import grade
+from autograder.plugin.timing import PHASES
+
+COLUMNS = ("child_start", *PHASES, "checks", "rest", "total")
 
 
 def main() -> None:
@@ -24,6 +30,8 @@ def main() -> None:
     exercises = [find_exercise(e) for e in args.exercises] or list_exercises()
     print(f"{'exercise':<22} {'score':>7} {'wall median':>12} {'min':>7} {'max':>7} "
           f"{'node seen after (median)':>25}  ticks idle/cpu share/cap")
+    phases: dict[str, list[dict[str, float]]] = {}
+    memory: dict[str, list[dict[str, float]]] = {}
     for exercise in exercises:
         walls, startups, scores = [], [], set()
         ticks: collections.Counter[str] = collections.Counter()
@@ -33,12 +41,38 @@ def main() -> None:
             walls.append(time.monotonic() - began)
             startups += result.data.get("startup_seconds", [])
             scores.add(f"{result.score}/{result.max_score}")
+            phases.setdefault(exercise.id, []).append(_phases(result.data.get("timing", {})))
+            if result.data.get("memory"):
+                memory.setdefault(exercise.id, []).append(result.data["memory"])
             for module in result.data.get("pacing", {}).values():
                 ticks.update({k: v for k, v in module.items() if k in ("idle", "budget", "cap")})
         startup = f"{statistics.median(startups):.2f} s" if startups else "-"
         print(f"{exercise.id:<22} {','.join(sorted(scores)):>7} "
               f"{statistics.median(walls):>10.2f} s {min(walls):>6.2f} {max(walls):>6.2f} "
               f"{startup:>25}  {ticks['idle']}/{ticks['budget']}/{ticks['cap']}", flush=True)
+    print("\nwhere the seconds went (median over runs, summed over test modules; rest: "
+          "the grader's own work outside the tests)")
+    print(f"{'exercise':<22}" + "".join(f"{c:>12}" for c in COLUMNS))
+    for name, runs in phases.items():
+        print(f"{name:<22}" + "".join(
+            f"{statistics.median(r[c] for r in runs):>12.2f}" for c in COLUMNS))
+    print("\npeak memory of a grading, MB (largest over runs; grader: pytest, world and "
+          "probe in one process; student: its largest process)")
+    print(f"{'exercise':<22} {'grader':>8} {'student':>8} {'total':>8}")
+    for name, runs in memory.items():
+        peak = max(runs, key=lambda m: m["total_mb"])
+        print(f"{name:<22} {peak['grader_mb']:>8.1f} {peak['student_mb']:>8.1f} "
+              f"{peak['total_mb']:>8.1f}")
+
+
+def _phases(timing: dict[str, Any]) -> dict[str, float]:
+    """One grading's seconds per column of :data:`COLUMNS`."""
+    modules = timing.get("modules", {}).values()
+    row = {p: sum(m[p] for m in modules) for p in (*PHASES, "checks")}
+    row["child_start"] = timing.get("child_start") or 0.0
+    row["total"] = timing.get("total", 0.0)
+    row["rest"] = max(0.0, row["total"] - row["child_start"] - timing.get("tests", 0.0))
+    return row
 
 
 if __name__ == "__main__":

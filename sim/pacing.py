@@ -146,6 +146,9 @@ class Pacer:
         self._window: collections.deque[tuple[float, float]] = collections.deque(maxlen=100)
         self.counts: collections.Counter[HoldOutcome] = collections.Counter()
         self.longest_hold = 0.0  # wall seconds of the longest hold for watched processes
+        # Wall seconds, summed, that holds ran past their tick's deadline: what a busy
+        # watched process cost in wall time (a hold within the tick's period costs none).
+        self.held_seconds = 0.0
 
     # -- run state ------------------------------------------------------------------
     @property
@@ -305,4 +308,6 @@ class Pacer:
                 break
             clock.sleep(policy.poll_interval)
         self.counts[outcome] += 1
-        self.longest_hold = max(self.longest_hold, clock.monotonic() - published)
+        ended = clock.monotonic()
+        self.longest_hold = max(self.longest_hold, ended - published)
+        self.held_seconds += max(0.0, ended - max(deadline, published))

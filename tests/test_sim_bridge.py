@@ -150,6 +150,21 @@ def test_pause_step_reset(graph: tuple[SimBridge, Probe]) -> None:
     assert bridge.effective_rtf > 0.5
 
 
+def test_waits_are_told_to_on_wait(graph: tuple[SimBridge, Probe]) -> None:
+    """Each wait on sim time tells the grader's timing how long it blocked and how much
+    of that the world was held (none here: no process is watched)."""
+    bridge, _probe = graph
+    told: list[tuple[float, float]] = []
+    bridge.on_wait = lambda seconds, held: told.append((seconds, held))
+    try:
+        assert bridge.wait_until(bridge.now + 0.1, wall_timeout=WALL)
+        assert bridge.wait_for(lambda: True, sim_timeout=1.0, wall_timeout=WALL)
+    finally:
+        bridge.on_wait = None
+    assert len(told) == 2
+    assert all(seconds >= 0 and held == 0 for seconds, held in told)
+
+
 def _rtf_over(bridge: SimBridge, sim_seconds: float) -> float:
     """Measured RTF over the next ``sim_seconds`` of sim time."""
     assert bridge.wait_until(bridge.now + 0.1, wall_timeout=WALL)  # fresh window

@@ -186,6 +186,21 @@ def test_a_starved_process_holds_until_the_cap() -> None:
     assert run.pacer.effective_rtf < 0.1  # 0.02 s of sim time per 2 s held
 
 
+def test_held_seconds_count_holds_past_the_deadline_only() -> None:
+    """A hold within the tick's period costs no wall time; past it, every second counts."""
+    clock = FakeClock()
+    process = FakeProcess(clock, idle_at=clock.now + 0.03)
+    run = Run(Pacer(DT, 1.0, clock=clock, read_process=process), clock)
+    run.pacer.watch(4242)
+    run.ticks_for(3)  # idle after 30 ms: within the 50 ms period
+    assert run.pacer.held_seconds == 0.0
+    starved = Run(Pacer(DT, 1.0, PacingPolicy(clock_hz=50.0), clock=clock,
+                        read_process=FakeProcess(clock, cpu_share=0.0)), clock)
+    starved.pacer.watch(4242)
+    starved.ticks_for(3)  # held to the 2 s cap, the period being 20 ms
+    assert starved.pacer.held_seconds == pytest.approx(3 * (2.0 - 0.02), abs=0.003)
+
+
 def test_every_watched_process_must_be_done() -> None:
     clock = FakeClock()
     idle_soon, computing = FakeProcess(clock, idle_at=clock.now), FakeProcess(clock)

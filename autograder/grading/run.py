@@ -143,6 +143,7 @@ def _run(exercise: Exercise, submission: Path | None, hidden: bool, lock: Domain
         log_path = Path(tmp) / "pytest.log"
         try:
             with log_path.open("wb") as log:
+                launched = time.monotonic()
                 child = subprocess.Popen(command, cwd=tmp, env=env, stdout=log,
                                          stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
                                          start_new_session=True,
@@ -157,9 +158,25 @@ def _run(exercise: Exercise, submission: Path | None, hidden: bool, lock: Domain
         raw = report.read(report_path, key, with_logs=True)
         _reap(child, raw)
         pytest_log = log_path.read_text(errors="replace")
-    result = _result(exercise, raw, child.returncode, timed_out, pytest_log,
-                     time.monotonic() - started, all_tests=hidden)
-    return result, raw
+    elapsed = time.monotonic() - started
+    result = _result(exercise, raw, child.returncode, timed_out, pytest_log, elapsed,
+                     all_tests=hidden)
+    return dataclasses.replace(result, data={
+        **result.data, "timing": _timing(raw.data, launched, elapsed),
+        **({"memory": raw.data["memory"]} if raw.data.get("memory") else {})}), raw
+
+
+def _timing(data: dict[str, Any], launched: float, elapsed: float) -> dict[str, Any]:
+    """The whole grading's wall seconds: the child's start (from its launch to its first
+    test: pytest, the plugin, collecting the tests), the tests (per module, see
+    :mod:`autograder.plugin.timing`) and the total, from the grader's call. ``launched``
+    is when the child was started (the monotonic clock, the same in both processes)."""
+    modules = data.get("timing", {})
+    first = data.get("first_test_at")
+    child_start = None if first is None else round(max(0.0, first - launched), 3)
+    return {"child_start": child_start,
+            "tests": round(sum(m.get("total", 0.0) for m in modules.values()), 3),
+            "total": round(elapsed, 3), "modules": modules}
 
 
 def _fault(exercise: Exercise, details: str, elapsed: float) -> RunResult:

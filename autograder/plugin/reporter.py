@@ -3,6 +3,8 @@ goes (registered by :mod:`autograder.plugin` only when an exercise is graded).""
 
 from __future__ import annotations
 
+import resource
+import time
 import traceback
 from collections.abc import Iterator
 from fractions import Fraction
@@ -26,6 +28,7 @@ from autograder.core.results import exact
 from autograder.i18n import _
 from autograder.plugin.msgtypes import type_note
 from autograder.plugin.stash import credit_key, evidence_key, settings_key
+from autograder.plugin.timing import Timing, module_of
 
 
 def _label(item: pytest.Item) -> str:
@@ -60,6 +63,7 @@ class GradingReporter:
         self.data: dict[str, Any] = {"logs": {}, "log_files": [], "recordings": {},
                                      "processes": []}
         self.hidden_default = "after_published"
+        self.timing = Timing()
 
     def write(self) -> None:
         if self.path is not None:
@@ -145,10 +149,32 @@ class GradingReporter:
             _lead_with(entry, type_note(item))
         _bound(entry)
 
+    @pytest.hookimpl(hookwrapper=True)
+    def pytest_runtest_protocol(self, item: pytest.Item) -> Iterator[None]:
+        """Time each test whole (setup, call, teardown) into its module's total."""
+        began = time.monotonic()
+        self.data.setdefault("first_test_at", began)
+        yield
+        self.timing.add(module_of(item.nodeid), "total", time.monotonic() - began)
+
+    def pytest_sessionfinish(self) -> None:
+        """The run's timing per module and its peak memory, into the report."""
+        self.data["timing"] = self.timing.to_dict()
+        self.data["memory"] = peak_memory()
+        self.write()
+
     def pytest_runtest_logfinish(self, nodeid: str) -> None:
         if nodeid in self.tests:
             self.tests[nodeid].done = True
         self.write()
+
+
+def peak_memory() -> dict[str, float]:
+    """Peak resident memory in MB: this process (pytest, the world and the probe) and the
+    largest student process it has waited for (each started program is, when stopped)."""
+    grader = round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, 1)  # KB
+    student = round(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024, 1)
+    return {"grader_mb": grader, "student_mb": student, "total_mb": round(grader + student, 1)}
 
 
 def _points(item: pytest.Item) -> Any:

@@ -17,6 +17,7 @@ from autograder.core.output import TAIL_BYTES, TAIL_LINES, describe_exit, messag
 from autograder.i18n import _
 from autograder.plugin.probe import GRADER_NODES
 from autograder.plugin.stash import reporter_key, settings_key, startup_key
+from autograder.plugin.timing import Timing, module_of
 from autograder.sandbox.graph import node_endpoints, wait_until_up
 
 if TYPE_CHECKING:
@@ -86,8 +87,6 @@ def launch(request: pytest.FixtureRequest, exercise: Exercise, script: Path, pro
            world: SimBridge, params: dict[str, Any] | None = None,
            wait_for_node: bool = True) -> StudentNode:
     """Start the student's program with ``use_sim_time:=true`` and wait for its node."""
-    from autograder.sandbox.process import student_process
-
     source = script.read_text(encoding="utf-8", errors="replace")
     try:
         compile(source, script.name, "exec")
@@ -100,6 +99,17 @@ def launch(request: pytest.FixtureRequest, exercise: Exercise, script: Path, pro
     ros_args = ["-p", "use_sim_time:=true"]
     for key, value in (params or {}).items():
         ros_args += ["-p", f"{key}:={_ros_value(value)}"]
+    reporter = request.config.stash.get(reporter_key, None)
+    timing = reporter.timing if reporter is not None else Timing()
+    with timing.phase(module_of(request.node.nodeid), "node_start"):
+        return _launch(request, exercise, script, probe, world, ros_args, wait_for_node)
+
+
+def _launch(request: pytest.FixtureRequest, exercise: Exercise, script: Path, probe: Probe,
+            world: SimBridge, ros_args: list[str], wait_for_node: bool) -> StudentNode:
+    """:func:`launch` once the program compiles: start it, wait for its node."""
+    from autograder.sandbox.process import student_process
+
     process = student_process(script, ros_args, exercise.limits,
                               domain=int(os.environ["ROS_DOMAIN_ID"]),
                               strict=request.config.stash[settings_key].strict,

@@ -15,6 +15,7 @@ from autograder.core.errors import StudentFailure
 from autograder.plugin.bag import attach_probe, close_bag, open_bag
 from autograder.plugin.probe import WORLD_NODE_NAME
 from autograder.plugin.stash import reporter_key, settings_key, type_watch_key
+from autograder.plugin.timing import Timing
 
 if TYPE_CHECKING:
     from rclpy.context import Context
@@ -22,6 +23,7 @@ if TYPE_CHECKING:
     from autograder.core.exercise import Exercise
     from autograder.plugin.probe import Probe
     from sim.bridge import SimBridge
+    from sim.worldfile import WorldSpec
 
 
 @pytest.fixture(scope="session")
@@ -82,8 +84,6 @@ def ros_context(pytestconfig: pytest.Config) -> Iterator[Context]:
 def world(request: pytest.FixtureRequest, exercise: Exercise,
           ros_context: Context) -> Iterator[SimBridge]:
     """The simulated world, running, for this test module (``@pytest.mark.world`` picks it)."""
-    from sim.bridge import SimBridge
-    from sim.physics import World
     from sim.worldfile import load_world
 
     marker = request.node.get_closest_marker("world")
@@ -91,23 +91,44 @@ def world(request: pytest.FixtureRequest, exercise: Exercise,
     local = exercise.folder / name
     spec = load_world(local if local.suffix in (".yaml", ".yml") and local.exists() else name)
     rtf = request.config.stash[settings_key].real_time_factor
-    bridge = SimBridge(World(spec), ros_context, node_name=WORLD_NODE_NAME,
-                       max_clock_hz=exercise.clock_hz,
-                       cpu_budget=exercise.cpu_budget,
-                       real_time_factor=exercise.real_time_factor if rtf is None else rtf,
-                       cmd_vel_type=exercise.cmd_vel_type)
-    bag = open_bag(request, bridge, spec.name)
-    bridge.start()
+    timing = _timing(request)
+    with timing.phase(request.node.nodeid, "world_start"):
+        bridge = _make_world(exercise, spec, ros_context, rtf)
+        bag = open_bag(request, bridge, spec.name)
+        bridge.start()
+    bridge.on_wait = lambda seconds, held: timing.waited(request.node.nodeid, seconds, held)
     try:
         yield bridge
     finally:
-        bridge.stop()
+        bridge.on_wait = None
+        with timing.phase(request.node.nodeid, "world_start"):
+            bridge.stop()
         close_bag(request, bag)
         reporter = request.config.stash.get(reporter_key, None)
         if reporter is not None:
             reporter.data["recordings"][request.node.name] = bridge.recording.to_dict()
             reporter.data.setdefault("pacing", {})[request.node.name] = {
-                **bridge.pacing, "longest_hold": round(bridge.longest_hold, 3)}
+                **bridge.pacing, "longest_hold": round(bridge.longest_hold, 3),
+                "held_seconds": round(bridge.pacer.held_seconds, 3)}
+
+
+def _timing(request: pytest.FixtureRequest) -> Timing:
+    """The run's timing (a throwaway one when the tests run without the reporter)."""
+    reporter = request.config.stash.get(reporter_key, None)
+    return reporter.timing if reporter is not None else Timing()
+
+
+def _make_world(exercise: Exercise, spec: WorldSpec, ros_context: Context,
+                rtf: float | None) -> SimBridge:
+    """The world for ``spec`` on the run's context, not yet started."""
+    from sim.bridge import SimBridge
+    from sim.physics import World
+
+    return SimBridge(World(spec), ros_context, node_name=WORLD_NODE_NAME,
+                     max_clock_hz=exercise.clock_hz,
+                     cpu_budget=exercise.cpu_budget,
+                     real_time_factor=exercise.real_time_factor if rtf is None else rtf,
+                     cmd_vel_type=exercise.cmd_vel_type)
 
 
 @pytest.fixture(scope="module")
@@ -116,11 +137,14 @@ def probe(request: pytest.FixtureRequest, ros_context: Context,
     """The grader's own node on the graph: publish, subscribe, call, set parameters."""
     from autograder.plugin.probe import Probe
 
-    node = Probe(ros_context, world)
-    attach_probe(request, node)
+    timing = _timing(request)
+    with timing.phase(request.node.nodeid, "world_start"):
+        node = Probe(ros_context, world)
+        attach_probe(request, node)
     # For the reporter: what the graph showed of types that never match (msgtypes.py).
     request.node.stash[type_watch_key] = node.types
     try:
         yield node
     finally:
-        node.close()
+        with timing.phase(request.node.nodeid, "world_start"):
+            node.close()
