@@ -1,7 +1,8 @@
 """grade-batch --jobs auto never changes a verdict: the proof's checks (references full,
 starter below the pass mark, each known-bad variant losing exactly its tests) hold for a
-batch graded at the concurrency auto chooses, for a CPU-light exercise (parameter_validation)
-and a clock-bound one whose verdicts hang on timing (timer_sync)."""
+batch graded at the concurrency auto chooses, for the clock-bound exercise whose verdicts
+hang most on timing (timer_sync). Every exercise's own proof runs three gradings at a time
+(tests/proving.py), and the mini course's batch compares auto with one by one."""
 
 from __future__ import annotations
 
@@ -21,7 +22,7 @@ pytestmark = pytest.mark.slow
 REFERENCES = 3
 
 
-@pytest.fixture(scope="module", params=["parameter_validation", "timer_sync"])
+@pytest.fixture(scope="module", params=["timer_sync"])
 def batch(request, tmp_path_factory) -> tuple[Proof, dict[str, RunResult], int]:
     """Every submission of the exercise's proof graded by one `grade-batch --jobs auto`:
     the proof, each student's result, and the concurrency auto chose."""
