@@ -1,7 +1,7 @@
 """grade-batch --jobs auto never changes a verdict: the proof's checks (references full,
 starter below the pass mark, each known-bad variant losing exactly its tests) hold for a
 batch graded at the concurrency auto chooses, for the clock-bound exercise whose verdicts
-hang most on timing (timer_sync). Every exercise's own proof runs three gradings at a time
+hang most on timing (timer_sync). Every exercise's own proof runs two gradings at a time
 (tests/proving.py), and the mini course's batch compares auto with one by one."""
 
 from __future__ import annotations
