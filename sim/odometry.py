@@ -32,16 +32,20 @@ class WheelOdometry:
 
     def step(self, v: float, w: float, dt: float) -> None:
         """Advance by ``dt`` at linear ``v`` and angular ``w`` (second-order Runge-Kutta,
-        as ROS's diff_drive_controller integrates)."""
-        heading = self.theta + w * dt / 2
-        self.x += v * dt * math.cos(heading)
-        self.y += v * dt * math.sin(heading)
-        self.theta = _wrap(self.theta + w * dt)
+        as ROS's diff_drive_controller integrates).  Runs every physics step, so it is kept
+        lean: the heading is wrapped when read, not here."""
         self.v, self.w = v, w
+        if v:
+            heading = self.theta + w * dt / 2
+            self.x += v * dt * math.cos(heading)
+            self.y += v * dt * math.sin(heading)
+        if w:
+            self.theta += w * dt
 
     @property
     def pose(self) -> tuple[float, float, float]:
-        return self.x, self.y, self.theta
+        """(x, y, theta) in ``odom``, theta wrapped to (-pi, pi]."""
+        return self.x, self.y, _wrap(self.theta)
 
 
 def to_odom(start: Pose, x: float, y: float) -> tuple[float, float]:
