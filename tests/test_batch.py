@@ -145,7 +145,7 @@ def run_folders(processes: set[tuple[int, str]]) -> set[Path]:
     return found
 
 
-def tests_done(folder: Path) -> int:
+def count_done(folder: Path) -> int:
     """How many tests a grading's pytest child has ended so far (its progress characters)."""
     log = folder / "pytest.log"
     text = log.read_text() if log.exists() else ""
@@ -184,7 +184,7 @@ def test_batch_resumes_after_being_killed(tmp_path, submissions, one_by_one, cou
     for pid, _start in running:
         with contextlib.suppress(ProcessLookupError):
             os.kill(pid, signal.SIGSTOP)
-    folders = {folder: tests_done(folder) for folder in run_folders(running)}
+    folders = {folder: count_done(folder) for folder in run_folders(running)}
     assert folders, "the batch had no grading running when it was killed"
     os.killpg(first.pid, signal.SIGKILL)
     first.wait()
@@ -199,7 +199,7 @@ def test_batch_resumes_after_being_killed(tmp_path, submissions, one_by_one, cou
     # still end (and, after the last test, the summary be printed) before the kill lands,
     # but no grading goes on to another test.
     for folder, done in folders.items():  # the dead batch could not remove them
-        assert tests_done(folder) <= done + 1, (folder / "pytest.log").read_text()[-2000:]
+        assert count_done(folder) <= done + 1, (folder / "pytest.log").read_text()[-2000:]
         shutil.rmtree(folder, ignore_errors=True)
     assert not all(folders.values()), "every grading had finished: the kill proved nothing"
     done_before = {p.parent.name for p in out.glob("*/results.json")}
