@@ -171,6 +171,11 @@ class SimBridge:
         """Also hold sim time back while process ``pid`` has work (None: watch nothing)."""
         self.pacer.watch(pid)
 
+    def closing_pid(self, pid: int) -> None:
+        """Process ``pid`` is being stopped: still hold ticks while it has work, but do not
+        wait for it to hear them."""
+        self.pacer.closing(pid)
+
     def unwatch_pid(self, pid: int) -> None:
         """Stop watching process ``pid``."""
         self.pacer.unwatch(pid)
@@ -289,6 +294,7 @@ class SimBridge:
         sec, nanosec = _stamp(self.world.time)
         clock = Clock()
         clock.clock.sec, clock.clock.nanosec = sec, nanosec
+        self.pacer.about_to_publish()
         self._clock_log.append((time.time_ns(), self.world.time))
         self._clock_pub.publish(clock)
         self._tap("/clock", clock, self.world.time)

@@ -28,6 +28,17 @@ processes, in milliseconds.
   wall-time cap alone, tried first, let sim time run on while a starved process waited
   for a CPU, and a correct node then failed under load.)  How each hold ended is counted
   (:attr:`Pacer.counts`; the results file's ``pacing``).
+* **Heard first.**  Idle only counts once the process has *heard* the tick: its CPU time
+  has grown since just before the tick went out (:meth:`Pacer.about_to_publish`), or it
+  is running.  On a loaded machine the kernel may hand a loopback datagram to the
+  student's socket late (receive work deferred to ``ksoftirqd``); a process read as idle
+  meanwhile has not started on the tick, and the next tick would overtake it (a 10 Hz
+  timer then skips a beat: seen in CI, eight gradings on two cores).  The hold waits up
+  to ``hear_timeout`` (0.5 s) for it, if it heard the tick before: whether it did is
+  judged over the whole time between the two ticks.  A process that hears no ticks (no
+  ``/clock`` subscription, or hung before making its node) thus costs one
+  ``hear_timeout``, not one per tick.  Ticks held this way are counted
+  (:attr:`Pacer.late_deliveries`: those the pacing would otherwise have let go early).
 * **Held.**  Inside :meth:`Pacer.held` (a student's program starting) no tick goes;
   afterwards the schedule starts afresh from that moment.
 
@@ -53,8 +64,9 @@ DEFAULT_CLOCK_HZ = 20.0
 DEFAULT_CPU_BUDGET = 0.05
 """CPU seconds a busy student process gets after a tick before the world goes on."""
 
-HoldOutcome = Literal["free", "idle", "budget", "cap"]
-"""How a tick's hold ended: nothing watched, all idle, CPU share used, or the wall cap."""
+HoldOutcome = Literal["free", "idle", "budget", "unheard", "cap"]
+"""How a tick's hold ended: nothing watched, all idle, CPU share used, a process that did
+not hear the tick within ``hear_timeout``, or the wall cap."""
 
 
 class Clock(Protocol):
@@ -98,6 +110,8 @@ class PacingPolicy:
     settle: float = 0.001
     """Pause after publishing before the first look at the processes: a reading taken at
     once would often find them idle only because the messages had not reached them."""
+    hear_timeout: float = 0.5
+    """Longest wait, from the tick's publication, for a watched process to hear it."""
     poll_interval: float = 0.0005
     max_tick: float = 2.0
     """Longest tick at RTF 0, in sim seconds."""
@@ -149,6 +163,12 @@ class Pacer:
         # Wall seconds, summed, that holds ran past their tick's deadline: what a busy
         # watched process cost in wall time (a hold within the tick's period costs none).
         self.held_seconds = 0.0
+        # Ticks held because a process was idle but had not heard the tick yet.
+        self.late_deliveries = 0
+        self._before: dict[int, int] = {}  # CPU ns of each watched process before a tick
+        self._heard: set[int] = set()  # those seen to hear the last tick during its hold
+        self._listening: set[int] = set()  # those that heard the tick before
+        self._closing: set[int] = set()  # those being stopped: never waited for to hear
 
     # -- run state ------------------------------------------------------------------
     @property
@@ -201,13 +221,45 @@ class Pacer:
         with self.condition:
             if pid is None:
                 self._pids.clear()
+                self._listening.clear()
+                self._closing.clear()
             else:
                 self._pids.add(pid)
+                self._listening.add(pid)
+                self._closing.discard(pid)
             self._window.clear()
 
     def unwatch(self, pid: int) -> None:
         with self.condition:
             self._pids.discard(pid)
+            self._listening.discard(pid)
+            self._closing.discard(pid)
+
+    def closing(self, pid: int) -> None:
+        """Process ``pid`` is being stopped: hold ticks while it has work, as before, but
+        no longer wait for it to hear them (its node is going away)."""
+        with self.condition:
+            self._closing.add(pid)
+            self._listening.discard(pid)
+
+    def about_to_publish(self) -> None:
+        """Read the watched processes' CPU time just before a tick goes out: a process
+        whose CPU time grows from here on has heard it.  Also judge, over the whole time
+        since the tick before, which of them heard that one: the next hold waits for
+        those to hear this tick (call with :attr:`condition` held)."""
+        states = {pid: self._read(pid) for pid in self._pids}
+        for pid, state in states.items():
+            if pid not in self._before:
+                continue
+            if pid in self._closing:
+                continue
+            if (pid in self._heard or not state.exists or state.busy
+                    or state.cpu_ns > self._before[pid]):
+                self._listening.add(pid)
+            else:
+                self._listening.discard(pid)
+        self._before = {pid: state.cpu_ns for pid, state in states.items()}
+        self._heard = set()
 
     # -- measuring ------------------------------------------------------------------
     def note_tick(self, sim_time: float) -> None:
@@ -280,14 +332,17 @@ class Pacer:
                                   max(self.dt, self._adaptive_tick * ratio))
 
     def _hold(self, published: float, deadline: float) -> None:
-        """Hold until every watched process is idle or has had its CPU share, or the cap.
+        """Hold until every watched process has heard the tick and is idle or has had its
+        CPU share, or the cap.
 
         A process that keeps computing is let go once it has used ``cpu_budget`` seconds of
         CPU since the tick (it is busy, not slow); one that is runnable but gets no CPU (a
-        busy machine) holds the world back, up to ``hold_cap`` of wall time.
+        busy machine) holds the world back, up to ``hold_cap`` of wall time; one that is
+        idle but has not heard the tick is waited for up to ``hear_timeout``.
         """
         with self.condition:
             pids = tuple(self._pids)
+            before, listening = dict(self._before), set(self._listening)
         if not pids:
             self.counts["free"] += 1
             return
@@ -296,18 +351,37 @@ class Pacer:
         now = clock.monotonic()
         if now < first:
             clock.sleep(first - now)
-        baseline = {pid: self._read(pid).cpu_ns for pid in pids}
+        # Without a reading from before the tick (a process watched since), the budget
+        # counts from now and the process counts as having heard the tick.
+        baseline = {pid: before[pid] if pid in before else self._read(pid).cpu_ns
+                    for pid in pids}
+        heard = {pid: pid not in before for pid in pids}
         budget_ns = int(policy.cpu_budget * 1e9)
         cap = published + policy.hold_cap
+        deafness = published + policy.hear_timeout
         outcome: HoldOutcome = "cap"
-        while clock.monotonic() < cap:
+        late = False
+        while (now := clock.monotonic()) < cap:
             states = {pid: self._read(pid) for pid in pids}
-            if not any(state.busy and state.cpu_ns - baseline[pid] < budget_ns
-                       for pid, state in states.items()):
+            for pid, state in states.items():
+                heard[pid] = heard[pid] or (not state.exists or state.busy
+                                            or state.cpu_ns > baseline[pid])
+            working = any(state.busy and state.cpu_ns - baseline[pid] < budget_ns
+                          for pid, state in states.items())
+            waiting = [pid for pid in listening if pid in heard and not heard[pid]]
+            if not working and waiting and now >= deafness:
+                outcome = "unheard"
+                break
+            if not working and not waiting:
                 outcome = "budget" if any(s.busy for s in states.values()) else "idle"
                 break
+            late = late or not working
             clock.sleep(policy.poll_interval)
+        with self.condition:
+            self._heard = {pid for pid, yes in heard.items() if yes}
         self.counts[outcome] += 1
+        if late and outcome != "unheard":
+            self.late_deliveries += 1
         ended = clock.monotonic()
         self.longest_hold = max(self.longest_hold, ended - published)
         self.held_seconds += max(0.0, ended - max(deadline, published))

@@ -9,7 +9,8 @@ Two facts per process, summed over its threads:
   ``/proc/<pid>/task/*/schedstat``).  Told apart from *busy*, it separates a process that
   computes (its CPU time grows) from one that only waits for a CPU (it does not).
 
-A process that is gone reads as idle with no CPU time: it has nothing left to react to.
+A process that is gone reads as idle with no CPU time and ``exists`` false: it has
+nothing left to react to.
 """
 
 from __future__ import annotations
@@ -25,9 +26,11 @@ class ProcessState:
 
     busy: bool
     cpu_ns: int
+    exists: bool = True
 
 
-IDLE = ProcessState(busy=False, cpu_ns=0)
+IDLE = ProcessState(busy=False, cpu_ns=0, exists=False)
+"""How a process that is gone reads."""
 
 ProcessReader = Callable[[int], ProcessState]
 """Reads the state of process ``pid`` (the pacing takes one, so tests can fake it)."""

@@ -173,7 +173,8 @@ def _rtf_over(bridge: SimBridge, sim_seconds: float) -> float:
 
 
 def test_watched_process_paces_sim_time(graph: tuple[SimBridge, Probe]) -> None:
-    """A busy student process holds sim time back; an idle one does not."""
+    """A busy student process holds sim time back; an idle one that hears no ticks does
+    not, once it has been waited for to hear one."""
     bridge, _ = graph
     bridge.set_real_time_factor(1.0)
     busy = subprocess.Popen([sys.executable, "-c", "while True: pass"])
@@ -185,9 +186,14 @@ def test_watched_process_paces_sim_time(graph: tuple[SimBridge, Probe]) -> None:
         let_go = bridge.pacing["budget"] - before.get("budget", 0)
         bridge.unwatch_pid(busy.pid)
         bridge.watch_pid(idle.pid)
+        # It hears no ticks (it has no node): the first is held hear_timeout for it.
+        unheard = bridge.pacing.get("unheard", 0)
+        assert bridge.wait_for(lambda: bridge.pacing.get("unheard", 0) > unheard, 5.0, WALL)
+        bridge.pacer.forget_rate()  # measure from here, not over that hold
         before = dict(bridge.pacing)
         free = _rtf_over(bridge, 0.4)
         waited_for_idle = bridge.pacing["idle"] - before.get("idle", 0)
+        unheard_again = bridge.pacing.get("unheard", 0) - before.get("unheard", 0)
     finally:
         bridge.watch_pid(None)
         for proc in (busy, idle):
@@ -195,8 +201,9 @@ def test_watched_process_paces_sim_time(graph: tuple[SimBridge, Probe]) -> None:
             proc.wait()
     # A tick is 0.02 s of sim time; a busy process gets 0.05 s of CPU before it passes.
     assert slowed < 0.6, slowed
-    assert free > 0.85, free
+    assert free > 0.85, (free, bridge.pacing)
     assert let_go > 0 and waited_for_idle > 0, bridge.pacing  # what the results report
+    assert unheard_again == 0, bridge.pacing  # not waited for to hear again
 
 
 STUDENT = """

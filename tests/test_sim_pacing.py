@@ -25,6 +25,7 @@ class FakeClock:
 
     def __init__(self) -> None:
         self.now = 100.0
+        self.ticks: list[float] = []  # when each tick went out
         self.waiting = threading.Event()  # set when a thread waits for the pacer to resume
 
     def monotonic(self) -> float:
@@ -43,16 +44,27 @@ class FakeProcess:
     """A student process as /proc would show it, as a function of the fake time.
 
     It is busy until ``idle_at`` and meanwhile gets ``cpu_share`` seconds of CPU per wall
-    second (1: it computes; 0: it is runnable but starved of a CPU)."""
+    second (1: it computes; 0: it is runnable but starved of a CPU).  It hears the ticks
+    that went out from ``hears_from`` on: each reaches it ``delay`` after it went out, and
+    it then computes for ``reaction`` (at least a microsecond: a message costs some CPU)."""
 
     clock: FakeClock
     idle_at: float = math.inf
     cpu_share: float = 1.0
+    hears_from: float = -math.inf
+    delay: float = 0.0
+    reaction: float = 0.0
 
     def __call__(self, pid: int) -> ProcessState:
         now = self.clock.now
-        return ProcessState(busy=now < self.idle_at,
-                            cpu_ns=round(min(now, self.idle_at) * self.cpu_share * 1e9))
+        busy = now < self.idle_at
+        cpu = min(now, self.idle_at) * self.cpu_share
+        for sent in (t for t in self.clock.ticks if t >= self.hears_from):
+            got = sent + self.delay
+            if got <= now:
+                cpu += min(now - got, self.reaction) + 1e-6
+                busy = busy or now < got + self.reaction
+        return ProcessState(busy=busy, cpu_ns=round(cpu * 1e9))
 
 
 @dataclass
@@ -69,7 +81,9 @@ class Run:
         """One tick: plan it, publish it (taking ``work(steps)`` wall seconds), pace it."""
         tick = self.pacer.next_tick()
         assert tick is not None
+        self.pacer.about_to_publish()
         self.published.append(self.clock.now)
+        self.clock.ticks.append(self.clock.now)
         self.clock.sleep(work(tick.steps))
         self.sim_time += tick.steps * DT
         self.pacer.note_tick(self.sim_time)
@@ -225,6 +239,74 @@ def test_a_gone_process_reads_idle() -> None:
     run.ticks_for(2)
     assert run.pacer.counts == {"idle": 2}
     assert run.pacer.longest_hold == pytest.approx(0.001)  # only the settle
+
+
+def test_an_idle_process_is_held_for_until_it_hears_the_tick() -> None:
+    """On a loaded machine a tick may reach the student's socket late: read idle before
+    then, the process has not started on it, and the next tick must not overtake it."""
+    clock = FakeClock()
+    process = FakeProcess(clock, idle_at=clock.now, delay=0.02, reaction=0.01)
+    run = Run(Pacer(DT, 1.0, clock=clock, read_process=process), clock)
+    run.pacer.watch(4242)
+    run.ticks_for(4)
+    assert run.pacer.counts == {"idle": 4}
+    assert run.pacer.late_deliveries == 4
+    assert run.pacer.longest_hold == pytest.approx(0.03, abs=0.001)  # heard, then done
+    assert run.gaps() == pytest.approx([0.05] * 3, abs=1e-9)  # within the period: no cost
+    prompt = FakeProcess(clock, idle_at=clock.now, reaction=0.01)
+    run = Run(Pacer(DT, 1.0, clock=clock, read_process=prompt), clock)
+    run.pacer.watch(4242)
+    run.ticks_for(4)
+    assert run.pacer.counts == {"idle": 4} and run.pacer.late_deliveries == 0
+
+
+def test_a_process_that_hears_no_ticks_costs_one_hear_timeout() -> None:
+    """No /clock subscription, or hung before making its node: waited for once."""
+    clock = FakeClock()
+    process = FakeProcess(clock, idle_at=clock.now, hears_from=math.inf)
+    run = Run(Pacer(DT, 1.0, clock=clock, read_process=process), clock)
+    run.pacer.watch(4242)
+    run.ticks_for(6)
+    assert run.pacer.counts == {"unheard": 1, "idle": 5}
+    assert run.pacer.late_deliveries == 0
+    assert run.gaps() == pytest.approx([0.5] + [0.05] * 4, abs=0.002)
+    process.hears_from, process.delay = clock.now, 0.02  # it hears, late: not waited for
+    run.tick()
+    assert run.pacer.late_deliveries == 0
+    run.ticks_for(2)  # having heard the tick before, it is waited for again
+    assert run.pacer.late_deliveries == 2
+
+
+def test_a_tick_heard_after_the_timeout_still_counts_as_heard() -> None:
+    """Whether a process heard a tick is judged up to the next tick: one delivery later
+    than hear_timeout does not stop the pacing from waiting for the following ones."""
+    clock = FakeClock()
+    process = FakeProcess(clock, idle_at=clock.now, delay=0.7)
+    run = Run(Pacer(DT, 1.0, clock=clock, read_process=process), clock)
+    run.pacer.watch(4242)
+    run.tick()
+    assert run.pacer.counts == {"unheard": 1}
+    clock.sleep(0.3)  # it hears the tick 0.7 s after it went out
+    process.delay = 0.02
+    run.ticks_for(2)
+    assert run.pacer.counts == {"unheard": 1, "idle": 2} and run.pacer.late_deliveries == 2
+
+
+def test_a_process_being_stopped_is_not_waited_for_to_hear() -> None:
+    """Once the grader stops a node, it stops hearing ticks: no hear_timeout for that."""
+    clock = FakeClock()
+    process = FakeProcess(clock, idle_at=clock.now, reaction=0.01)
+    run = Run(Pacer(DT, 1.0, clock=clock, read_process=process), clock)
+    run.pacer.watch(4242)
+    run.ticks_for(2)
+    run.pacer.closing(4242)
+    process.hears_from = math.inf  # its node is gone; the process is still exiting
+    run.ticks_for(3)
+    assert run.pacer.counts == {"idle": 5}
+    assert run.gaps() == pytest.approx([0.05] * 4, abs=1e-9)
+    process.idle_at = math.inf  # still busy (cleaning up): held for its work as before
+    run.tick()
+    assert run.pacer.counts == {"idle": 5, "budget": 1}
 
 
 def test_a_long_hold_is_not_caught_up() -> None:

@@ -146,6 +146,8 @@ class NodeRun:
         notes: list[str] = []
         if self.process is not None:
             ended_by_itself = not self.running()
+            if self._bridge is not None and self.process.popen is not None:
+                self._bridge.closing_pid(self.process.pid)
             status = self.process.stop()
             if self._bridge is not None and self.process.popen is not None:
                 self._bridge.unwatch_pid(self.process.pid)

@@ -70,9 +70,11 @@ class StudentNode:
 
     def send_signal(self, sig: int) -> None:
         """Signal the program's process group, as Ctrl-C in its terminal would."""
+        self.probe.world.closing_pid(self.process.pid)
         self.process.signal(sig)
 
     def stop(self) -> int | None:
+        self.probe.world.closing_pid(self.process.pid)
         status = self.process.stop()
         self.probe.world.unwatch_pid(self.process.pid)
         if self.process.uid is not None:  # strict: our own folder in /tmp, not the run's

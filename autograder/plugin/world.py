@@ -109,7 +109,8 @@ def world(request: pytest.FixtureRequest, exercise: Exercise,
             reporter.data["recordings"][request.node.name] = bridge.recording.to_dict()
             reporter.data.setdefault("pacing", {})[request.node.name] = {
                 **bridge.pacing, "longest_hold": round(bridge.longest_hold, 3),
-                "held_seconds": round(bridge.pacer.held_seconds, 3)}
+                "held_seconds": round(bridge.pacer.held_seconds, 3),
+                "late_deliveries": bridge.pacer.late_deliveries}
 
 
 def _timing(request: pytest.FixtureRequest) -> Timing:
