@@ -118,8 +118,24 @@ def observe(probe, world, streams: Streams) -> Run:
         finally:
             world.set_real_time_factor(pace)
     end = probe.now if frozen is None else frozen + FROZEN
+    if frozen is None:
+        _let_in_flight_arrive(probe, commands, end)
     return Run(start, switch, end, commands.items, streams.statuses.items,
                streams.plans.items, frozen)
+
+
+def _let_in_flight_arrive(probe, commands, end: float) -> None:
+    """Wait until what the node sent before ``end`` has reached us, not only been sent.
+
+    On a loaded machine the probe may receive a message a tick or more after the node
+    sent it; a window read at ``end`` would miss the last ones and show a gap at its edge
+    that the node never had.  The node's messages reach us in the order it sent them (one
+    reliable writer), so once a command it sent two beats after ``end`` is in, every
+    earlier one is too, and the status and plans it sent before are taken by then (same
+    socket, an earlier spin).  A node that stops right at ``end`` costs one second.
+    """
+    after = end + 2.0 / CONTROL_HZ
+    probe.wait_for(lambda: bool(commands.times) and commands.times[-1] >= after - 1e-9, 1.0)
 
 
 # -- checks --------------------------------------------------------------------------
