@@ -32,12 +32,14 @@ import ast
 import dataclasses
 import difflib
 import functools
+import json
 import os
 import re
 import sys
 import tempfile
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
+from typing import Any
 
 import yaml
 
@@ -292,6 +294,19 @@ def failures(result: RunResult) -> dict[str, str]:
     return {t.name: f"{t.status}: {t.message}" for t in result.tests if t.status != "passed"}
 
 
+def explain(**parts: Any) -> str:
+    """An assertion message in full: pytest cuts a dict's repr short, never a string."""
+    return json.dumps(parts, indent=1, ensure_ascii=False, default=str)
+
+
+def diagnosis(result: RunResult) -> dict[str, Any]:
+    """What a failed proof prints of a grading: what each lost test said, how the world
+    paced itself, where the time went (a verdict that changed under load says why)."""
+    return {"lost": failures(result), "grader_error": result.grader_error,
+            "grader_details": result.grader_details[-2000:],
+            **{key: result.data[key] for key in ("pacing", "timing") if key in result.data}}
+
+
 _BOTH_TYPES = (re.compile(r"geometry_msgs/msg/Twist\b"),
                re.compile(r"geometry_msgs/msg/TwistStamped\b"))
 
@@ -307,7 +322,8 @@ def test_reference_scores_full_marks_every_time(graded: dict[str, RunResult],
                                                 proof: Proof) -> None:
     results = [graded[f"reference#{i}"] for i in range(proof.repeats)]
     assert [r.grader_error for r in results] == [None] * proof.repeats
-    assert all(r.score == r.max_score for r in results), [failures(r) for r in results]
+    assert all(r.score == r.max_score for r in results), explain(
+        runs=[diagnosis(r) for r in results])
     assert len({r.max_score for r in results}) == 1
     assert all(r.passed for r in results)
 
@@ -323,7 +339,7 @@ def test_other_correct_designs_score_full_marks(graded: dict[str, RunResult],
                                                 correct: str) -> None:
     result = graded[correct]
     assert result.grader_error is None
-    assert result.score == result.max_score, failures(result)
+    assert result.score == result.max_score, explain(**diagnosis(result))
 
 
 def test_known_bad_variant_loses_exactly_the_tests_aimed_at_it(
@@ -335,10 +351,11 @@ def test_known_bad_variant_loses_exactly_the_tests_aimed_at_it(
     assert result.grader_error is None
     assert result.score < result.max_score
     lost = failed_tests(result)
-    assert variant.loses <= lost <= variant.loses | variant.may_also_lose, {
-        "why": variant.why, "lost": failures(result),
-        "passed, though expected lost": sorted(variant.loses - lost),
-        "lost, though not expected": sorted(lost - variant.loses - variant.may_also_lose)}
+    assert variant.loses <= lost <= variant.loses | variant.may_also_lose, explain(
+        why=variant.why, **{
+            "passed, though expected lost": sorted(variant.loses - lost),
+            "lost, though not expected": sorted(lost - variant.loses - variant.may_also_lose)},
+        **diagnosis(result))
 
 
 def test_known_bad_variant_is_told_what_was_observed(

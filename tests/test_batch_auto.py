@@ -12,7 +12,7 @@ import subprocess
 import sys
 
 import pytest
-from proving import Proof, failed_tests, failures
+from proving import Proof, diagnosis, explain, failed_tests
 
 from autograder.core.exercise import find_exercise
 from autograder.core.results import RunResult
@@ -53,8 +53,8 @@ def test_references_score_full_marks(batch) -> None:
     _proof, results, jobs = batch
     for i in range(REFERENCES):
         result = results[f"reference{i}"]
-        assert result.grader_error is None, (jobs, result.grader_details)
-        assert result.score == result.max_score, (jobs, failures(result))
+        assert result.grader_error is None, explain(jobs=jobs, **diagnosis(result))
+        assert result.score == result.max_score, explain(jobs=jobs, **diagnosis(result))
 
 
 def test_starter_is_below_the_pass_mark(batch) -> None:
@@ -69,11 +69,10 @@ def test_variants_lose_exactly_what_their_proof_says(batch) -> None:
     for name, variant in proof.variants.items():
         result = results[name]
         lost = failed_tests(result)
-        if result.grader_error is not None:
-            wrong[name] = result.grader_details
-        elif variant.kind == "correct" and result.score != result.max_score:
-            wrong[name] = failures(result)
+        if result.grader_error is not None or (
+                variant.kind == "correct" and result.score != result.max_score):
+            wrong[name] = diagnosis(result)
         elif variant.kind != "correct" and not (
                 variant.loses <= lost <= variant.loses | variant.may_also_lose):
-            wrong[name] = {"expected": sorted(variant.loses), "lost": failures(result)}
-    assert not wrong, {"jobs": jobs, "wrong": wrong}
+            wrong[name] = {"expected": sorted(variant.loses), **diagnosis(result)}
+    assert not wrong, explain(jobs=jobs, wrong=wrong)

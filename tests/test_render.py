@@ -202,3 +202,15 @@ def test_urdu_html_report_is_right_to_left():
     assert "Noto Nastaliq Urdu" in page
     assert '<code dir="ltr">cmd_vel</code>' in page
     assert '<pre dir="ltr">' in page
+
+
+def test_the_results_file_reads_back_with_its_timing_memory_and_pacing():
+    """A batch resuming from its reports, and the proofs' diagnoses, read these back."""
+    data = {"isolation": {"mode": "strict"}, "timing": {"total": 9.1, "modules": {}},
+            "memory": {"grader_mb": 90.0, "student_mb": 80.0, "total_mb": 170.0},
+            "pacing": {"test_a.py": {"idle": 10, "late_deliveries": 1}},
+            "warnings": ["w"], "bags": {"test_a.py": "a.mcap"}}
+    written = json.loads(to_json(dataclasses.replace(result(), data=data)))
+    again = RunResult.from_dict(written)
+    assert again.data == data
+    assert json.loads(to_json(again)) == written

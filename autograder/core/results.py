@@ -107,6 +107,10 @@ class NotRun:
         return _("The grade also runs hidden tests.")
 
 
+_RUN_DATA = ("isolation", "pacing", "bags", "warnings", "timing", "memory")
+"""What :meth:`RunResult.to_dict` writes from ``data``, and ``from_dict`` reads back."""
+
+
 @dataclasses.dataclass(frozen=True)
 class RunResult:
     """A whole grading run: what every renderer is a pure function of."""
@@ -168,6 +172,7 @@ class RunResult:
                    pass_mark=exact(data.get("pass_mark", "0.7")), lang=data.get("lang", "en"),
                    grader_error=data.get("grader_error"),
                    execution_time=data.get("execution_time", 0.0),
+                   data={key: data[key] for key in _RUN_DATA if key in data},
                    not_run=NotRun.from_dict(data["not_run"]) if data.get("not_run") else None)
 
     def to_dict(self) -> dict[str, Any]:
