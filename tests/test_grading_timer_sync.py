@@ -82,7 +82,7 @@ def test_report_plots_the_intervals_each_rate_test_measured(graded):
     (control,) = charts["test_control_rate"]
     assert control["title"] == "cmd_vel"
     assert control["limit"] == pytest.approx(0.15)  # the largest gap allowed
-    assert len(control["points"]) > 250  # 30 s at 10 Hz
+    assert len(control["points"]) > 180  # 23 s at 10 Hz, less what discovery took
     assert all(gap <= control["limit"] for _t, gap in control["points"])  # the reference keeps it
     assert len(charts["test_control_while_planning"]) >= 2  # one per planner run
     for name in ("test_status_rate", "test_plan_rate", "test_rates_at_half_speed"):

@@ -39,6 +39,9 @@ class StudentNode:
         self.name = name
         self.probe = probe
         self.startup_seconds: float | None = None
+        # Sim time when the node was seen on the graph: time stood still while it started,
+        # so its timers were created at this time (None: not waited for, or never seen).
+        self.appeared_at: float | None = None
         self.on_stop = on_stop
         # The program runs from a throwaway folder; its tracebacks name the student's own
         # folder instead ("" for the file's bare name), line numbers as they are.
@@ -181,6 +184,7 @@ def _wait_for_node(exercise: Exercise, node: StudentNode, world: SimBridge,
                           exercise.startup_timeout)
     if found:
         node.startup_seconds = time.monotonic() - node.process.started_at
+        node.appeared_at = world.now
         return
     if not node.running():
         raise _exited_at_start(node, exercise)

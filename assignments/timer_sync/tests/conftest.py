@@ -15,12 +15,15 @@ from helpers import Streams, observe  # noqa: E402
 @pytest.fixture(scope="module")
 def streams(probe, student):
     """cmd_vel, status and plan, each stamped with the sim time it was published at."""
-    return Streams(commands=probe.subscribe(Twist, "/cmd_vel", stamp="published"),
+    started = student.appeared_at if student.appeared_at is not None else probe.now
+    return Streams(started=started,
+                   commands=probe.subscribe(Twist, "/cmd_vel", stamp="published"),
                    statuses=probe.subscribe(String, "/status", stamp="published"),
                    plans=probe.subscribe(String, "/plan", stamp="published"))
 
 
 @pytest.fixture(scope="module")
 def run(probe, world, streams):
-    """30 s of simulation time watched once per module: 20 s at RTF 1, then 10 s at 0.5."""
+    """Watched once per module, 23.5 s of simulation time from the node's start: to 20.5 s at
+    the world's pace, then at half that (helpers.SWITCH_AT, END_AT)."""
     return observe(probe, world, streams)

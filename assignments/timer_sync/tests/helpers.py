@@ -25,8 +25,14 @@ PLAN_SECONDS = 2.0
 # timed by the wall clock runs at twice its rates in sim time.  Not RTF 2: its ticks
 # are 0.1 s of sim time, one control period, so a node one tick slow to react loses a
 # beat (measured: the chapter's design lost one in six runs beside another grading).
-FIRST_SECONDS = 24.0
-OTHER_SECONDS = 6.0
+# The run is timed from the node's start (``Streams.started``: sim time stands still while
+# it starts, so its timers begin then), not from its first message, which discovery may
+# delay: the pace changes at SWITCH_AT and the window closes at END_AT after the start,
+# 23 s in all.  The planner runs from 10 to 12 s and from 20 to 22 s, so both plans are
+# in, and the second run always falls in the half-pace phase.  Three seconds at half pace
+# show a wall-clock node's doubled rates (60 commands and 6 statuses against 30 and 3).
+SWITCH_AT = 20.5
+END_AT = 23.5
 OTHER_RTF = 0.5
 # Discovery may cost the first messages: the window opens this long after the first one.
 SETTLE = 0.5
@@ -38,6 +44,7 @@ RATE_TOLERANCE = 0.03
 
 @dataclass
 class Streams:
+    started: float
     commands: Any
     statuses: Any
     plans: Any
@@ -102,19 +109,21 @@ def _change_pace(probe, world, rtf: float) -> float:
 
 
 def observe(probe, world, streams: Streams) -> Run:
-    """Watch the node for FIRST_SECONDS at the world's pace, then OTHER_SECONDS at OTHER_RTF."""
+    """Watch the node at the world's pace until SWITCH_AT after its start, then at OTHER_RTF
+    until END_AT."""
     commands = streams.commands
     if not probe.wait_for(lambda: len(commands) > 0, 5.0):
         return Run(None, None, probe.now, [], streams.statuses.items, streams.plans.items)
-    start = commands.times[0] + SETTLE
+    start = max(streams.started, commands.times[0]) + SETTLE
     probe.wait_for(lambda: probe.now >= start, SETTLE + 1.0)
-    frozen = _watch(probe, streams, FIRST_SECONDS, 1.0)
+    frozen = _watch(probe, streams, streams.started + SWITCH_AT - probe.now, 1.0)
     switch = None
     if frozen is None:
         pace = world.real_time_factor
         switch = _change_pace(probe, world, OTHER_RTF)
         try:
-            frozen = _watch(probe, streams, OTHER_SECONDS, 1.0 / OTHER_RTF)
+            frozen = _watch(probe, streams, streams.started + END_AT - probe.now,
+                            1.0 / OTHER_RTF)
         finally:
             world.set_real_time_factor(pace)
     end = probe.now if frozen is None else frozen + FROZEN
