@@ -76,7 +76,10 @@ def grade(exercise: Exercise, submission: Path | None, *, hidden: bool = True,
     return dataclasses.replace(result, data={
         **result.data, "isolation": {**isolation.to_dict(), "bounds": bounds},
         "domain": first, "domains": [lock.domain for lock in locks], "processes": processes,
-        "student_uid": student_uid(first) if isolation.strict else None})
+        "student_uid": student_uid(first) if isolation.strict else None,
+        # Each child's students run as the user of its domain.
+        "student_uids": [student_uid(lock.domain) for lock in locks] if isolation.strict
+        else None})
 
 
 def _more_domains(stack: contextlib.ExitStack, count: int) -> list[DomainLock]:
