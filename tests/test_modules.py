@@ -3,12 +3,17 @@
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import pytest
 
+from autograder.core.exercise import load_exercise
 from autograder.core.report import RawReport, RawTest
+from autograder.core.results import RunResult
+from autograder.grading.children import Ended
 from autograder.grading.modules import children_for, find_modules, merge, share_out
+from autograder.grading.run import GRADER_FAULT, _result
 
 PUBLIC, HIDDEN_A, HIDDEN_B = "tests/public/test_p.py", "tests/hidden/test_a.py", \
     "tests/hidden/test_b.py"
@@ -145,3 +150,36 @@ def test_a_grading_runs_its_modules_in_two_children_on_two_domains() -> None:
     assert set(result.data["timing"]["modules"]) == modules
     assert set(result.data["pacing"]) == {m.rpartition("/")[2] for m in modules}
     assert set(result.data["recordings"]) == set(result.data["pacing"])
+
+
+SHOUT = Path(__file__).parent / "fixtures" / "mini_course" / "assignments" / "shout"
+
+
+def _ended(*tests: RawTest, returncode: int | None = 1, timed_out: bool = False,
+           log: str = "") -> Ended:
+    return Ended(RawReport(tests=list(tests)), returncode, timed_out, log, 0.0)
+
+
+def _outcome(*ended: Ended) -> RunResult:
+    raw = merge([e.raw for e in ended], ORDER)
+    return _result(load_exercise(SHOUT), raw, ended, 1.0)
+
+
+def test_a_child_stopped_at_the_time_limit_says_so_for_its_own_tests_only() -> None:
+    unfinished = dataclasses.replace(_test(HIDDEN_A, "a"), done=False, status="error")
+    result = _outcome(_ended(_test(PUBLIC, "p"), _test(HIDDEN_B, "b"), returncode=0),
+                      _ended(unfinished, returncode=None, timed_out=True))
+    assert [(t.name, t.status) for t in result.tests] == [
+        ("p", "passed"), ("a", "failed"), ("b", "passed")]
+    assert "time limit" in result.tests[1].message
+    assert result.grader_error is None and result.data["timed_out"] is True
+    assert result.score == 2
+
+
+def test_a_child_that_broke_is_the_graders_fault_with_its_own_log() -> None:
+    result = _outcome(_ended(_test(PUBLIC, "p"), returncode=0, log="fine"),
+                      _ended(returncode=2, log="ImportError in test_a.py"))
+    assert result.grader_error == GRADER_FAULT
+    assert "ImportError in test_a.py" in result.grader_details
+    assert "fine" not in result.grader_details
+    assert [t.name for t in result.tests] == ["p"]  # the others' results still count
