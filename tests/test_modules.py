@@ -183,3 +183,35 @@ def test_a_child_that_broke_is_the_graders_fault_with_its_own_log() -> None:
     assert "ImportError in test_a.py" in result.grader_details
     assert "fine" not in result.grader_details
     assert [t.name for t in result.tests] == ["p"]  # the others' results still count
+
+
+@pytest.mark.parametrize(("options", "expected"), [
+    ([], "auto"), (["--jobs", "2"], 1), (["--jobs", "auto"], 1),
+    (["--jobs", "2", "--module-jobs", "3"], 3),
+], ids=["one-grading-at-a-time", "several", "auto", "explicit"])
+def test_grade_batch_runs_modules_at_once_only_when_it_grades_one_at_a_time(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, options: list[str],
+        expected: int | str) -> None:
+    from click.testing import CliRunner
+
+    from autograder.cli import main
+    from autograder.grading import run
+
+    monkeypatch.setenv("AUTOGRADER_COURSE", str(SHOUT.parent.parent))
+    asked: list[int | str] = []
+
+    def fake_grade(exercise, path, *, module_jobs="auto", **_kw):  # noqa: ANN001, ANN202
+        asked.append(module_jobs)
+        return RunResult(kind="exercise", id="shout", title="Shout", tests=())
+
+    monkeypatch.setattr(run, "grade", fake_grade)
+    monkeypatch.setattr("autograder.grading.capacity.auto_chooser",
+                        lambda report=None: lambda share, students: 2)
+    (tmp_path / "subs").mkdir()
+    for student in ("alice", "bob"):
+        (tmp_path / "subs" / f"{student}.py").write_text("")
+    outcome = CliRunner().invoke(main, ["grade-batch", "shout", str(tmp_path / "subs"),
+                                        "--csv", str(tmp_path / "g.csv"), "--out",
+                                        str(tmp_path / "out"), *options])
+    assert outcome.exit_code == 0, outcome.output
+    assert asked == [expected, expected]
