@@ -118,7 +118,8 @@ def start(exercise: str, directory: Path | None) -> None:
 
 
 def _run(exercise: str, submission: Path, hidden: bool, outputs: dict[str, Path | None],
-         rtf: float | None, domain: int | None, record: Path | None = None) -> None:
+         rtf: float | None, domain: int | None, record: Path | None = None,
+         module_jobs: int | str = "auto") -> None:
     from autograder.core.report import RawTest
     from autograder.core.submission import SubmissionNotFound, locate
     from autograder.grading.run import grade, result_of
@@ -147,7 +148,7 @@ def _run(exercise: str, submission: Path, hidden: bool, outputs: dict[str, Path 
     try:
         result = grade(found, submission, hidden=hidden, domain=domain, real_time_factor=rtf,
                        progress=lambda raw: live.done(result_of(raw)), running=running,
-                       record=record)
+                       record=record, module_jobs=module_jobs)
     finally:
         live.close()
     click.echo(to_terminal(result, color=color, shown=live.shown, with_heading=False))
@@ -205,6 +206,31 @@ _rtf = click.option("--real-time-factor", "rtf", type=float, default=None,
                     help="Override the exercise's simulation pace.")
 _domain = click.option("--domain", type=click.IntRange(0, 232), default=None,
                        help="ROS domain id (default: a free one, reserved for the run).")
+
+
+class _ModuleJobsType(click.ParamType):
+    """``--module-jobs``: test modules run at once in one grading (1 to 64), or ``auto``."""
+
+    name = "N|auto"
+
+    def convert(self, value, param, ctx):  # noqa: ANN001, ANN201
+        if isinstance(value, int) or value == "auto":
+            return value
+        try:
+            jobs = int(value)
+        except ValueError:
+            jobs = 0
+        if not 1 <= jobs <= 64:
+            self.fail(_("--module-jobs must be a number from 1 to 64 or auto, got {value}"
+                        ).format(value=value), param, ctx)
+        return jobs
+
+
+_module_jobs = click.option(
+    "--module-jobs", type=_ModuleJobsType(), default="auto", show_default=True,
+    help="Test modules run at the same time within the grading, each in a child of its "
+         "own on its own ROS domain; 'auto': one per module as far as the cores go. "
+         "--domain means 1.")
 _record = click.option("--record", type=click.Path(path_type=Path, file_okay=False),
                        default=None, help="Record each test module's ROS graph as a rosbag2 "
                        "bag (MCAP) in this folder.")
@@ -216,12 +242,13 @@ _record = click.option("--record", type=click.Path(path_type=Path, file_okay=Fal
 @_formats
 @_rtf
 @_domain
+@_module_jobs
 @_record
 @_lang_option
 def check(exercise: str, submission: Path, rtf: float | None, domain: int | None,
-          record: Path | None, **outputs: Path | None) -> None:
+          module_jobs: int | str, record: Path | None, **outputs: Path | None) -> None:
     """Run the public tests of EXERCISE on SUBMISSION (for students)."""
-    _run(exercise, submission, False, outputs, rtf, domain, record)
+    _run(exercise, submission, False, outputs, rtf, domain, record, module_jobs)
 
 
 @main.command("grade")
@@ -230,13 +257,15 @@ def check(exercise: str, submission: Path, rtf: float | None, domain: int | None
 @_formats
 @_rtf
 @_domain
+@_module_jobs
 @_record
 @_lang_option
 def grade_command(exercise: str, submission: Path, rtf: float | None, domain: int | None,
-                  record: Path | None, **outputs: Path | None) -> None:
+                  module_jobs: int | str, record: Path | None,
+                  **outputs: Path | None) -> None:
     """Run the public and hidden tests of EXERCISE on SUBMISSION (the student's .py file or a
     folder holding it)."""
-    _run(exercise, submission, True, outputs, rtf, domain, record)
+    _run(exercise, submission, True, outputs, rtf, domain, record, module_jobs)
 
 
 @main.command()
@@ -304,9 +333,12 @@ class _JobsType(click.ParamType):
               help="Grade only share I of N (stable: by a hash of the student's name).")
 @click.option("--record", type=click.Path(path_type=Path, file_okay=False), default=None,
               help="Record each student's grading as rosbag2 bags (MCAP) in RECORD/<student>.")
+@click.option("--module-jobs", type=_ModuleJobsType(), default=None,
+              help="Test modules run at the same time within each grading (default: auto "
+                   "with --jobs 1, else 1: the gradings share the cores).")
 @_lang_option
 def grade_batch(item: str, submissions: Path, jobs: int | str, csv_path: Path, out: Path | None,
-                shard: str | None, record: Path | None) -> None:
+                shard: str | None, record: Path | None, module_jobs: int | str | None) -> None:
     """Grade every submission in SUBMISSIONS (one sub-folder or file per student), or score
     every answers file for a quiz. Resumable: graded students are skipped."""
     from autograder.commands.batch import parse_shard, run_batch, students
@@ -317,7 +349,9 @@ def grade_batch(item: str, submissions: Path, jobs: int | str, csv_path: Path, o
         raise UsageProblem(_("--shard must be I/N with 1 <= I <= N, got {value}").format(
             value=shard)) from None
     out = out or Path("grades") / item
-    grade_one, suffix, extra = _batch_item(item, record)
+    if module_jobs is None:  # several gradings at once already keep the cores busy
+        module_jobs = "auto" if jobs == 1 else 1
+    grade_one, suffix, extra = _batch_item(item, record, module_jobs)
 
     def progress(student: str, result) -> None:  # noqa: ANN001
         if result is None:
@@ -335,9 +369,10 @@ def grade_batch(item: str, submissions: Path, jobs: int | str, csv_path: Path, o
         count=len(rows), path=csv_path))
 
 
-def _batch_item(item: str, record: Path | None = None):  # noqa: ANN202
+def _batch_item(item: str, record: Path | None = None,  # noqa: ANN202
+                module_jobs: int | str = "auto"):
     """How to grade one student's entry for an exercise or a quiz (``record``: a folder
-    for each student's bags, exercises only)."""
+    for each student's bags, exercises only; ``module_jobs``: see :func:`grade`)."""
     from autograder.grading.run import grade
     from autograder.quiz.catalog import find_quiz
     from autograder.quiz.scoring import read_answers, score
@@ -358,7 +393,8 @@ def _batch_item(item: str, record: Path | None = None):  # noqa: ANN202
         def grade_one(path: Path):  # noqa: ANN202 - a RunResult
             # The student's name as `students()` gives it: a folder's name, a file's stem.
             student = path.name if path.is_dir() else path.stem
-            return grade(exercise, path, record=record / student if record else None)
+            return grade(exercise, path, record=record / student if record else None,
+                         module_jobs=module_jobs)  # type: ignore[arg-type]
 
         return grade_one, None, extra
     if record is not None:

@@ -4,7 +4,10 @@ ticks went on (student idle, CPU share used, wall cap hit: see sim/bridge.py); t
 the seconds went (the results file's ``timing``, summed over test modules, median over
 the runs) and the peak memory of a grading (``memory``, the largest over the runs).
 
-    python benchmarks/bench_grading.py [--runs 5] [EXERCISE ...]
+    python benchmarks/bench_grading.py [--runs 5] [--module-jobs auto] [EXERCISE ...]
+
+``--module-jobs`` as for ``autograder grade``; with more than 1 the modules overlap, so
+their seconds add up to more than the wall time and ``rest`` reads 0.
 """
 
 from __future__ import annotations
@@ -25,6 +28,8 @@ COLUMNS = ("child_start", *PHASES, "checks", "rest", "total")
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=5)
+    parser.add_argument("--module-jobs", default="auto",
+                        type=lambda v: v if v == "auto" else int(v))
     parser.add_argument("exercises", nargs="*")
     args = parser.parse_args()
     exercises = [find_exercise(e) for e in args.exercises] or list_exercises()
@@ -37,7 +42,7 @@ def main() -> None:
         ticks: collections.Counter[str] = collections.Counter()
         for _ in range(args.runs):
             began = time.monotonic()
-            result = grade(exercise, None)
+            result = grade(exercise, None, module_jobs=args.module_jobs)
             walls.append(time.monotonic() - began)
             startups += result.data.get("startup_seconds", [])
             scores.add(f"{result.score}/{result.max_score}")

@@ -167,7 +167,8 @@ def test_grade_batch_records_each_student_in_a_folder_of_their_own(
 
     monkeypatch.setenv("AUTOGRADER_COURSE", str(COURSE))
     asked: list[Path | None] = []
-    monkeypatch.setattr(run, "grade", lambda exercise, path, record=None: asked.append(record))
+    monkeypatch.setattr(run, "grade", lambda exercise, path, record=None, **_kw:
+                        asked.append(record))
     (tmp_path / "bob").mkdir()
     grade_one, _, _ = cli._batch_item("shout", tmp_path / "bags")
     grade_one(tmp_path / "alice.py")

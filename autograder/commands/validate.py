@@ -4,6 +4,7 @@ mark, and every quiz lints.  Each problem is a ``file:line: message``."""
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -101,7 +102,9 @@ def validate(root: Path | None = None, *, run_gradings: bool = True, jobs: int =
         def check(exercise: Exercise) -> list[Problem]:
             if progress:
                 progress(exercise.id)
-            return _gradings(exercise, grade)
+            # Several gradings at once already share the cores: one child each.
+            return _gradings(exercise, functools.partial(
+                grade, module_jobs=1 if jobs > 1 else "auto"))
 
         with ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
             for found in pool.map(check, exercises):

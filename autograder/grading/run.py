@@ -1,63 +1,69 @@
-"""Grade a submission: run the exercise's tests in a child pytest, turn its report into a
-:class:`~autograder.core.results.RunResult`.
+"""Grade a submission: run the exercise's tests in child pytests, turn their reports into
+a :class:`~autograder.core.results.RunResult`.
 
-The tests (and the world and probe they use) run in a child process, so a crash there is
+The tests (and the world and probe they use) run in child processes, so a crash there is
 reported as a grader fault instead of taking the CLI down, and a run past its time limit
-is stopped with everything it started.
+is stopped with everything it started.  Test modules run in several children at once,
+each on a ROS domain of its own (:mod:`autograder.grading.modules`), so a grading takes
+about as long as its slowest module.
 """
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import os
-import secrets
-import signal
-import subprocess
-import sys
 import tempfile
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
-from autograder.core import report
 from autograder.core.exercise import Exercise
 from autograder.core.report import RawReport, RawTest
 from autograder.core.results import NotRun, RunResult, TestResult, exact
 from autograder.core.settings import RunSettings
+from autograder.grading import children
+from autograder.grading.capacity import machine_cores
+from autograder.grading.children import Progress, Watchers
+from autograder.grading.modules import ModuleJobs, children_for, find_modules, merge, share_out
 from autograder.i18n import _, get_language
 from autograder.sandbox.domains import DomainLock, NoDomain, hold_domain
 from autograder.sandbox.isolation import Isolation, detect, run_prefix, student_uid
-from autograder.sandbox.process import reap_recorded
 
 GRADER_FAULT = "the autograder failed, tell your instructor"
 
-
-Progress = Callable[[RawTest], None]
 
 
 def grade(exercise: Exercise, submission: Path | None, *, hidden: bool = True,
           domain: int | None = None, real_time_factor: float | None = None,
           progress: Progress | None = None,
           running: Callable[[RawTest | None], None] | None = None,
-          record: Path | None = None) -> RunResult:
+          record: Path | None = None, module_jobs: ModuleJobs = "auto") -> RunResult:
     """Run the exercise's public (and, with ``hidden``, hidden) tests on ``submission``.
 
     ``submission`` is the student's file or a folder holding it; None grades the reference
     solution.  Always returns a result: a broken submission scores what it showed, a fault
     of ours sets ``grader_error``.  ``progress`` gets each test as it finishes;
-    ``running``, a few times a second, the test that runs now (None between tests).
+    ``running``, a few times a second, a test that runs now (None between tests).
     With ``record``, each test module's graph is recorded as a rosbag2 bag in that folder
     (``data["bags"]``); a recording that fails is only a warning (``data["warnings"]``).
+    ``module_jobs`` children run the test modules at once, each on a domain of its own
+    (``auto``: one per module as far as the cores go); a given ``domain`` means one child.
     """
     started = time.monotonic()
     isolation = detect()
     record, warnings = _record_folder(record)
+    plan = _Plan.of(exercise, hidden)
+    wanted = 1 if domain is not None else children_for(module_jobs, len(plan.modules),
+                                                          machine_cores())
     try:
-        with hold_domain(domain) as lock:
-            result, raw = _run(exercise, submission, hidden, lock, isolation,
-                               real_time_factor, _Watchers(progress, running), started,
+        with contextlib.ExitStack() as stack:
+            locks = [stack.enter_context(hold_domain(domain))]
+            locks += _more_domains(stack, wanted - 1)
+            result, raw = _run(exercise, submission, plan, locks, isolation,
+                               real_time_factor, Watchers(progress, running), started,
                                record)
     except NoDomain as exc:
         return _fault(exercise, str(exc), time.monotonic() - started)
@@ -66,10 +72,60 @@ def grade(exercise: Exercise, submission: Path | None, *, hidden: bool = True,
             **result.data, "warnings": warnings + result.data.get("warnings", [])})
     processes = raw.processes
     bounds = processes[0].get("bounds") if processes else None
+    first = locks[0].domain
     return dataclasses.replace(result, data={
         **result.data, "isolation": {**isolation.to_dict(), "bounds": bounds},
-        "domain": lock.domain, "processes": processes,
-        "student_uid": student_uid(lock.domain) if isolation.strict else None})
+        "domain": first, "domains": [lock.domain for lock in locks], "processes": processes,
+        "student_uid": student_uid(first) if isolation.strict else None,
+        # Each child's students run as the user of its domain.
+        "student_uids": [student_uid(lock.domain) for lock in locks] if isolation.strict
+        else None})
+
+
+def _more_domains(stack: contextlib.ExitStack, count: int) -> list[DomainLock]:
+    """Up to ``count`` more free domains, held until ``stack`` closes (fewer if the
+    machine has fewer free: the modules then share fewer children)."""
+    locks: list[DomainLock] = []
+    for _index in range(count):
+        try:
+            locks.append(stack.enter_context(hold_domain()))
+        except NoDomain:
+            break
+    return locks
+
+
+@dataclasses.dataclass(frozen=True)
+class _Plan:
+    """What a grading runs: its test folders, the modules to share out among children and
+    the folders only counted (``check``: the hidden tests)."""
+
+    folders: tuple[Path, ...]
+    modules: tuple[Path, ...]
+    count_only: tuple[Path, ...]
+    all_tests: bool  # the hidden tests run too (a grade, not a check)
+
+    @classmethod
+    def of(cls, exercise: Exercise, hidden: bool) -> _Plan:
+        # A public run collects the hidden tests too, only to count them (see the reporter).
+        folders = tuple(f for f in (exercise.public_tests, exercise.hidden_tests)
+                        if f.is_dir())
+        count_only = () if hidden else tuple(f for f in folders
+                                             if f == exercise.hidden_tests)
+        run = [f for f in folders if f not in count_only]
+        return cls(folders, tuple(find_modules(run)), count_only, hidden)
+
+    def targets(self, children: int) -> list[list[Path]]:
+        """Each child's pytest arguments: the folders for one child (as pytest collects
+        them), else groups of modules, the first child also counting ``count_only``."""
+        if children <= 1 or len(self.modules) <= 1:
+            return [list(self.folders)]
+        groups = share_out(self.modules, children)
+        return [group + (list(self.count_only) if i == 0 else [])
+                for i, group in enumerate(groups)]
+
+    def order(self, root: Path) -> list[str]:
+        """The modules' node-id paths (relative to pytest's rootdir) in collection order."""
+        return [Path(os.path.relpath(m, root)).as_posix() for m in self.modules]
 
 
 def _record_folder(record: Path | None) -> tuple[Path | None, list[str]]:
@@ -86,14 +142,6 @@ def _record_folder(record: Path | None) -> tuple[Path | None, list[str]]:
     return record, []
 
 
-@dataclasses.dataclass(frozen=True)
-class _Watchers:
-    """Who is told how the run goes (see :func:`grade`)."""
-
-    progress: Progress | None = None
-    running: Callable[[RawTest | None], None] | None = None
-
-
 def _shown_name(exercise: Exercise, submission: Path | None) -> str:
     """The student's file as they named it, for messages: the path they gave (or the file
     in the folder they gave), else the exercise's file name."""
@@ -107,70 +155,47 @@ def _shown_name(exercise: Exercise, submission: Path | None) -> str:
         return exercise.file
 
 
-def _run(exercise: Exercise, submission: Path | None, hidden: bool, lock: DomainLock,
-         isolation: Isolation, real_time_factor: float | None, watchers: _Watchers,
-         started: float, record: Path | None = None) -> tuple[RunResult, RawReport]:
-    """One grading in a child pytest on the reserved domain; the result and raw report.
-
-    The child gets its :class:`~autograder.core.settings.RunSettings` as one document. It
-    inherits the domain's lock (it holds the domain as long as it lives) and the read end
-    of a *lifeline* pipe whose write end only this process holds: when this process dies,
-    however it dies, the child sees the pipe close and ends itself and every student
-    process it started (see ``autograder.plugin``)."""
-    # A public run collects the hidden tests too, only to count them (see the reporter).
-    folders = [f for f in (exercise.public_tests, exercise.hidden_tests) if f.is_dir()]
-    count_only = () if hidden else tuple(str(f) for f in folders
-                                         if f == exercise.hidden_tests)
+def _run(exercise: Exercise, submission: Path | None, plan: _Plan,
+         locks: Sequence[DomainLock], isolation: Isolation, real_time_factor: float | None,
+         watchers: Watchers, started: float, record: Path | None = None,
+         ) -> tuple[RunResult, RawReport]:
+    """One grading in child pytests, one per reserved domain; the result and the merged
+    raw report. Each child gets its :class:`~autograder.core.settings.RunSettings` as one
+    document (see :mod:`autograder.grading.children`)."""
+    targets = plan.targets(len(locks))
+    settings = RunSettings(
+        exercise=str(exercise.folder),
+        submission=str(Path(submission).resolve()) if submission is not None else None,
+        course=str(exercise.folder.parent.parent), real_time_factor=real_time_factor,
+        isolation=isolation.mode, lang=get_language(),
+        record=str(record) if record is not None else None,
+        submission_name=_shown_name(exercise, submission))
     with tempfile.TemporaryDirectory(prefix="autograder-") as tmp:
-        report_path = Path(tmp) / "report.json"
-        key = secrets.token_bytes(32)
-        key_read, key_write = os.pipe()
-        life_read, life_write = os.pipe()
-        settings = RunSettings(
-            exercise=str(exercise.folder),
-            submission=str(Path(submission).resolve()) if submission is not None else None,
-            course=str(exercise.folder.parent.parent), report=str(report_path),
-            key_fd=key_read, lifeline_fd=life_read, domain=lock.domain,
-            real_time_factor=real_time_factor, isolation=isolation.mode, lang=get_language(),
-            record=str(record) if record is not None else None,
-            submission_name=_shown_name(exercise, submission), count_only=count_only)
-        command = [
-            *run_prefix(isolation), sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
-            "--rootdir", str(exercise.folder), "--basetemp", str(Path(tmp) / "pytest"),
-            "--autograder-settings", settings.to_json(), *(str(f) for f in folders),
-        ]
-        env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1")
-        log_path = Path(tmp) / "pytest.log"
-        try:
-            with log_path.open("wb") as log:
-                launched = time.monotonic()
-                child = subprocess.Popen(command, cwd=tmp, env=env, stdout=log,
-                                         stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
-                                         start_new_session=True,
-                                         pass_fds=(key_read, life_read, *lock.fds))
-                os.close(key_read)
-                os.close(life_read)
-                with os.fdopen(key_write, "wb") as pipe:
-                    pipe.write(key)
-                timed_out = _wait(child, exercise.time_limit, report_path, key, watchers)
-        finally:
-            os.close(life_write)
-        raw = report.read(report_path, key, with_logs=True)
-        _reap(child, raw)
-        pytest_log = log_path.read_text(errors="replace")
+        with contextlib.ExitStack() as lifelines:
+            running = []
+            for index, (group, lock) in enumerate(zip(targets, locks, strict=False)):
+                count_only = tuple(str(f) for f in plan.count_only if f in group)
+                running.append(lifelines.enter_context(children.started(
+                    run_prefix(isolation), dataclasses.replace(settings, count_only=count_only),
+                    [str(t) for t in group], Path(tmp) / f"child-{index}", exercise.folder,
+                    lock)))
+            children.wait(running, exercise.time_limit, watchers)
+        ended = [children.end(child) for child in running]
     elapsed = time.monotonic() - started
-    result = _result(exercise, raw, child.returncode, timed_out, pytest_log, elapsed,
-                     all_tests=hidden)
+    raw = merge(([e.raw for e in ended]), plan.order(exercise.folder))
+    result = _result(exercise, raw, ended, elapsed, all_tests=plan.all_tests)
+    timing = _timing(raw.data, min(e.launched for e in ended), elapsed)
     return dataclasses.replace(result, data={
-        **result.data, "timing": _timing(raw.data, launched, elapsed),
+        **result.data, "timing": {**timing, "children": len(ended)},
         **({"memory": raw.data["memory"]} if raw.data.get("memory") else {})}), raw
 
 
 def _timing(data: dict[str, Any], launched: float, elapsed: float) -> dict[str, Any]:
-    """The whole grading's wall seconds: the child's start (from its launch to its first
-    test: pytest, the plugin, collecting the tests), the tests (per module, see
-    :mod:`autograder.plugin.timing`) and the total, from the grader's call. ``launched``
-    is when the child was started (the monotonic clock, the same in both processes)."""
+    """The whole grading's wall seconds: the children's start (from the first launch to
+    the first test: pytest, the plugin, collecting the tests), the tests (per module, see
+    :mod:`autograder.plugin.timing`; summed, so more than ``total`` when modules run at
+    once) and the total, from the grader's call. ``launched`` is when the first child was
+    started (the monotonic clock, the same in every process)."""
     modules = data.get("timing", {})
     first = data.get("first_test_at")
     child_start = None if first is None else round(max(0.0, first - launched), 3)
@@ -185,47 +210,6 @@ def _fault(exercise: Exercise, details: str, elapsed: float) -> RunResult:
                      tests=(), pass_mark=exercise.pass_fraction, lang=get_language(),
                      grader_error=GRADER_FAULT, grader_details=details,
                      execution_time=elapsed)
-
-
-def _wait(child: subprocess.Popen[bytes], limit: float, report_path: Path, key: bytes,
-          watchers: _Watchers) -> bool:
-    """Wait for the pytest child, telling ``watchers`` as tests run and finish; True if it
-    ran over its time limit."""
-    deadline = time.monotonic() + limit
-    reported: set[str] = set()
-    while True:
-        try:
-            child.wait(timeout=0.25)
-            finished = True
-        except subprocess.TimeoutExpired:
-            finished = False
-        if watchers.progress is not None or watchers.running is not None:
-            tests = report.read(report_path, key).tests
-            for test in tests:
-                if test.done and test.nodeid not in reported:
-                    reported.add(test.nodeid)
-                    if watchers.progress is not None:
-                        watchers.progress(test)
-            if watchers.running is not None:
-                # Tests run in the order they were collected: the first not done runs now.
-                watchers.running(None if finished else
-                                 next((t for t in tests if not t.done), None))
-        if finished:
-            return False
-        if time.monotonic() > deadline:
-            os.killpg(child.pid, signal.SIGKILL)
-            child.wait()
-            return True
-
-
-def _reap(child: subprocess.Popen[bytes], raw: RawReport) -> None:
-    """Make sure nothing the run started outlives it (the child's group, students' cgroups)."""
-    try:
-        os.killpg(child.pid, signal.SIGKILL)
-    except (ProcessLookupError, PermissionError):
-        pass
-    for process in raw.processes:
-        reap_recorded(process)
 
 
 def result_of(raw: RawTest, status: str | None = None,
@@ -272,16 +256,18 @@ def _module_of(nodeid: str) -> str:
     return nodeid.partition("::")[0].rpartition("/")[2]
 
 
-def _result(exercise: Exercise, raw_report: RawReport, returncode: int | None,
-            timed_out: bool, pytest_log: str, elapsed: float,
-            all_tests: bool = True) -> RunResult:
+def _result(exercise: Exercise, raw_report: RawReport, ended: Sequence[children.Ended],
+            elapsed: float, all_tests: bool = True) -> RunResult:
+    """The verdict on the merged report: each child's tests as that child ended (those of
+    a child stopped at the time limit say so; a child that broke is the grader's fault)."""
     if raw_report.forged:
         return _forged(exercise, elapsed)
+    stopped = {t.nodeid for e in ended if e.timed_out for t in e.raw.tests}
     tests = []
     errors = []
     for raw in raw_report.tests:
         test = result_of(raw)
-        if timed_out and raw.status == "error" and not raw.done:
+        if raw.nodeid in stopped and raw.status == "error" and not raw.done:
             test = result_of(raw, "failed", _(
                 "Not run: grading stopped at its time limit of {seconds:.0f} s.").format(
                 seconds=exercise.time_limit))
@@ -290,11 +276,11 @@ def _result(exercise: Exercise, raw_report: RawReport, returncode: int | None,
         tests.append(test)
     grader_error = None
     details = ""
-    broken_run = returncode not in (0, 1) and not timed_out  # e.g. a test file that
-    if errors or not tests or broken_run:                    # does not import
+    broken = [e for e in ended if e.broken]  # e.g. a test file that does not import
+    if errors or not tests or broken:
         grader_error = GRADER_FAULT
-        details = "\n\n".join(errors + ([pytest_log[-4000:]] if broken_run or not tests
-                                          else []))
+        logs = [e.pytest_log[-4000:] for e in (broken or (ended if not tests else []))]
+        details = "\n\n".join(errors + logs)
     total = sum((t.max_score for t in tests), Fraction(0))
     # Only a run of every test can check the total (`check` runs the public ones alone).
     if exercise.points and tests and all_tests and total != exercise.points \
@@ -311,7 +297,8 @@ def _result(exercise: Exercise, raw_report: RawReport, returncode: int | None,
         grader_details=details, log_tail="\n".join(logs.values())[-4000:],
         log=raw_report.output_log, not_run=not_run,
         execution_time=elapsed,
-        data={"recordings": data.get("recordings", {}), "timed_out": timed_out,
+        data={"recordings": data.get("recordings", {}),
+              "timed_out": any(e.timed_out for e in ended),
               "startup_seconds": data.get("startup_seconds", []),
               "pacing": data.get("pacing", {}), "bags": data.get("bags", {}),
               "warnings": data.get("warnings", [])})

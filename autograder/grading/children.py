@@ -1,0 +1,158 @@
+"""The child pytests of one grading: started, watched, stopped at the time limit, reaped.
+
+Each child runs a group of whole test modules on a ROS domain of its own, with its own
+signed report, key, lifeline and settings (see :func:`autograder.grading.run.grade`).
+The child inherits its domain's lock (it holds the domain as long as it lives) and the
+read end of a *lifeline* pipe whose write end only the grader holds: when the grader
+dies, however it dies, the child sees the pipe close and ends itself and every student
+process it started (see ``autograder.plugin``).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import os
+import secrets
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import Callable, Iterator, Sequence
+from pathlib import Path
+
+from autograder.core import report
+from autograder.core.report import RawReport, RawTest
+from autograder.core.settings import RunSettings
+from autograder.sandbox.domains import DomainLock
+from autograder.sandbox.process import reap_recorded
+
+Progress = Callable[[RawTest], None]
+
+
+@dataclasses.dataclass(frozen=True)
+class Watchers:
+    """Who is told how the run goes (see :func:`autograder.grading.run.grade`)."""
+
+    progress: Progress | None = None
+    running: Callable[[RawTest | None], None] | None = None
+
+
+@dataclasses.dataclass
+class Child:
+    """One running child pytest and where it reports."""
+
+    process: subprocess.Popen[bytes]
+    report_path: Path
+    key: bytes
+    log_path: Path
+    launched: float  # monotonic, the same clock in both processes
+    timed_out: bool = False
+
+
+@dataclasses.dataclass(frozen=True)
+class Ended:
+    """One child after it ended: its report (with the programs' logs), exit status and
+    pytest's own output."""
+
+    raw: RawReport
+    returncode: int | None
+    timed_out: bool
+    pytest_log: str
+    launched: float
+
+    @property
+    def broken(self) -> bool:
+        """It ended without reporting its tests: a crash or a test file that does not
+        import, or the time limit before any test was collected."""
+        return (self.returncode not in (0, 1) and not self.timed_out) or (
+            not self.raw.forged and not self.raw.tests)
+
+
+@contextlib.contextmanager
+def started(prefix: Sequence[str], settings: RunSettings, targets: Sequence[str],
+            folder: Path, rootdir: Path, lock: DomainLock) -> Iterator[Child]:
+    """Start one child pytest over ``targets`` (test folders or modules) in ``folder``;
+    its lifeline closes when the block ends."""
+    folder.mkdir(parents=True, exist_ok=True)
+    report_path = folder / "report.json"
+    key = secrets.token_bytes(32)
+    key_read, key_write = os.pipe()
+    life_read, life_write = os.pipe()
+    settings = dataclasses.replace(settings, report=str(report_path), key_fd=key_read,
+                                   lifeline_fd=life_read, domain=lock.domain)
+    command = [
+        *prefix, sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
+        "--rootdir", str(rootdir), "--basetemp", str(folder / "pytest"),
+        "--autograder-settings", settings.to_json(), *targets,
+    ]
+    env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1")
+    log_path = folder / "pytest.log"
+    try:
+        with log_path.open("wb") as log:
+            launched = time.monotonic()
+            process = subprocess.Popen(command, cwd=folder, env=env, stdout=log,
+                                       stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
+                                       start_new_session=True,
+                                       pass_fds=(key_read, life_read, *lock.fds))
+        os.close(key_read)
+        os.close(life_read)
+        with os.fdopen(key_write, "wb") as pipe:
+            pipe.write(key)
+        yield Child(process, report_path, key, log_path, launched)
+    finally:
+        os.close(life_write)
+
+
+def wait(children: Sequence[Child], limit: float, watchers: Watchers) -> None:
+    """Wait for every child, telling ``watchers`` as tests run and finish; a child still
+    running ``limit`` seconds from now is stopped (``timed_out``) with all it started."""
+    deadline = time.monotonic() + limit
+    reported: set[str] = set()
+    while True:
+        live = [c for c in children if c.process.poll() is None]
+        if live:
+            with contextlib.suppress(subprocess.TimeoutExpired):
+                live[0].process.wait(timeout=0.25)
+        finished = all(c.process.poll() is not None for c in children)
+        if watchers.progress is not None or watchers.running is not None:
+            now = _tell(children, reported, watchers)
+            if watchers.running is not None:
+                watchers.running(None if finished else now)
+        if finished:
+            return
+        if time.monotonic() > deadline:
+            for child in children:
+                if child.process.poll() is None:
+                    os.killpg(child.process.pid, signal.SIGKILL)
+                    child.process.wait()
+                    child.timed_out = True
+            return
+
+
+def _tell(children: Sequence[Child], reported: set[str], watchers: Watchers) -> RawTest | None:
+    """Tell ``progress`` each test that finished since last time; the test that runs now
+    in some running child (each runs its tests in collection order: the first not done)."""
+    running = None
+    for child in children:
+        tests = report.read(child.report_path, child.key).tests
+        for test in tests:
+            if test.done and test.nodeid not in reported:
+                reported.add(test.nodeid)
+                if watchers.progress is not None:
+                    watchers.progress(test)
+        if running is None and child.process.returncode is None:
+            running = next((t for t in tests if not t.done), None)
+    return running
+
+
+def end(child: Child) -> Ended:
+    """The child's report, read (with its programs' logs) before anything is removed, and
+    everything it started reaped (its process group, the students' cgroups)."""
+    raw = report.read(child.report_path, child.key, with_logs=True)
+    with contextlib.suppress(ProcessLookupError, PermissionError):
+        os.killpg(child.process.pid, signal.SIGKILL)
+    for process in raw.processes:
+        reap_recorded(process)
+    return Ended(raw, child.process.returncode, child.timed_out,
+                 child.log_path.read_text(errors="replace"), child.launched)
