@@ -4,7 +4,8 @@ Both the ROS bridge and the benchmark drive a :class:`Simulation`; it says which
 outputs fall due at each physics step (odometry at 50 Hz, scans at 10 Hz of sim time) and
 the bridge only turns them into messages.  Odometry comes twice: the ground truth in the
 world frame, which the recording keeps for the grader, and the wheel odometry in the
-robot's ``odom`` frame (REP 105), integrated every step, which goes out on /odom.
+robot's ``odom`` frame (REP 105), integrated over every step (each run of unchanged
+velocities at once), which goes out on /odom.
 """
 
 from __future__ import annotations
