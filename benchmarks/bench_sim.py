@@ -4,8 +4,10 @@ with the ROS bridge publishing as fast as it can (RTF 0, no watched process).
 Measured on a 2-core AMD EPYC shared with other work (2026-11, Python 3.11, pymunk 7.3,
 NumPy 2.4): physics + lidar 917x real time (median of 5 runs, 877 to 953 over runs), a
 scan 25 us; before the ray cast was rewritten, 339x and 110 us in the same hour.  With
-the ROS bridge, 36x (the clock cap bounds it).  ``benchmarks/bench_peers.py`` runs the
-same loop beside MuJoCo, PyBullet and ir-sim.
+the ROS bridge, 36x (the clock cap bounds it).  Later, on a busier machine, trimming the
+step (odometry in closed form, Chipmunk's step called directly) took physics + lidar from
+654x to 755x (medians of 3, same hour), the scan 40 us with its noise.
+``benchmarks/bench_peers.py`` runs the same loop beside MuJoCo, PyBullet and ir-sim.
 
 Run: ``python benchmarks/bench_sim.py [--sim-seconds 60] [--runs 5] [--domain 99]``.
 """

@@ -53,20 +53,25 @@ class FaultInjector:
         self.seed = seed
         self.lidar = lidar or Lidar()
         self._placed: set[int] = set()
+        self.obstacles_pending = self._any_obstacle_pending()
+        """Whether an obstacle is yet to be placed: the simulation asks every step."""
 
     def add(self, fault: Fault) -> None:
         """Add a fault at run time (it takes effect from its ``start``)."""
         if fault.kind not in KINDS:
             raise ValueError(f"unknown fault kind {fault.kind!r}")
         self.faults.append(fault)
+        self.obstacles_pending = self._any_obstacle_pending()
 
     def reset(self) -> None:
         """Forget which obstacles were placed (the world was rebuilt)."""
         self._placed.clear()
+        self.obstacles_pending = self._any_obstacle_pending()
 
     def due_obstacles(self, t: float) -> list[Box | Circle]:
         """Obstacles whose time has come and that were not placed yet."""
         due: list[Box | Circle] = []
+        placed = len(self._placed)
         for i, fault in enumerate(self.faults):
             places = KINDS[fault.kind].places
             if places is not None and i not in self._placed and fault.start <= t:
@@ -74,7 +79,13 @@ class FaultInjector:
                 obstacle = places(fault)
                 if obstacle is not None:
                     due.append(obstacle)
+        if len(self._placed) != placed:
+            self.obstacles_pending = self._any_obstacle_pending()
         return due
+
+    def _any_obstacle_pending(self) -> bool:
+        return any(KINDS[fault.kind].places is not None and i not in self._placed
+                   for i, fault in enumerate(self.faults))
 
     def apply(self, t: float, ranges: np.ndarray) -> Scan | None:
         """The scan to publish at ``t`` from clean ``ranges``, or None during a dropout."""

@@ -30,6 +30,17 @@ _STATIC = 2
 # checkers: the same C calls, a third of the Python cost, 200 times a simulated second.
 _set_velocity = pymunk.Body.velocity.fset
 _set_angular_velocity = pymunk.Body.angular_velocity.fset
+# Space.step's work besides the C step: adds, removals and callbacks deferred during a
+# step, and bodies to check.  While none is pending (every step but the first, here) the
+# world calls the C step through pymunk's own binding, as Space.step does, without the
+# wrapper's Python (a fifth of a step's cost); otherwise, or if pymunk's internals are
+# not the ones expected, it calls Space.step.
+_SPACE_PENDING = ("_bodies_to_check", "_add_later", "_remove_later", "_post_step_callbacks",
+                  "_removed_shapes")
+try:
+    from pymunk._chipmunk_cffi import lib as _chipmunk
+except ImportError:  # pragma: no cover - another pymunk layout: the public API only
+    _chipmunk = None
 
 
 # What a contact names.  ``Contact.what`` is data ("wall 3"): recordings keep it as is in
@@ -121,6 +132,11 @@ class World:
             self._add_circle(circle, f"circle {i}")
         self._build_robot()
         self.space.on_collision(_ROBOT, _STATIC, begin=self._on_begin)
+        self._c_space = self._c_robot = self._c_control = None
+        if (_chipmunk is not None and not self.space.threaded
+                and all(hasattr(self.space, name) for name in _SPACE_PENDING)):
+            self._c_space = self.space._space
+            self._c_robot, self._c_control = self.robot._body, self.control._body
 
     def _build_robot(self) -> None:
         start = self.spec.start
@@ -199,11 +215,27 @@ class World:
             v = _approach(v, self._target[0], lim.max_linear_accel * self.dt)
             w = _approach(w, self._target[1], lim.max_angular_accel * self.dt)
             self._command = (v, w)
-        heading = self.robot.rotation_vector
-        _set_velocity(self.control, (heading.x * v, heading.y * v))
-        _set_angular_velocity(self.control, w)
-        self.space.step(self.dt)
+        space = self.space
+        if self._c_space is None or (
+                space._bodies_to_check or space._add_later or space._remove_later
+                or space._post_step_callbacks or space._removed_shapes):
+            heading = self.robot.rotation_vector
+            _set_velocity(self.control, (heading.x * v, heading.y * v))
+            _set_angular_velocity(self.control, w)
+            space.step(self.dt)
+        else:  # the same C calls, without pymunk's Python around them
+            heading = _chipmunk.cpBodyGetRotation(self._c_robot)
+            _chipmunk.cpBodySetVelocity(self._c_control, (heading.x * v, heading.y * v))
+            _chipmunk.cpBodySetAngularVelocity(self._c_control, w)
+            space._locked = True  # as in Space.step (this world's callback defers nothing)
+            _chipmunk.cpSpaceStep(self._c_space, self.dt)
+            space._locked = False
         self.steps += 1
+
+    @property
+    def has_contacts(self) -> bool:
+        """Whether contacts began since :meth:`drain_contacts` was last called."""
+        return bool(self._contacts)
 
     def drain_contacts(self) -> list[Contact]:
         """Contacts that began since the last call."""

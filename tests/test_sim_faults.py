@@ -81,6 +81,19 @@ def test_obstacle_appears_at_its_time_and_blocks_the_robot() -> None:
     assert len(sim.world.geometry[1]) == 1  # placed again after the reset
 
 
+def test_obstacles_are_looked_for_only_while_one_is_pending() -> None:
+    faults = FaultInjector([nan_readings(0.0)])
+    assert not faults.obstacles_pending  # the simulation skips due_obstacles each step
+    faults.add(obstacle_at(1.0, Circle(center=(1.0, 1.0), radius=0.1)))
+    faults.add(obstacle_at(2.0, Circle(center=(2.0, 1.0), radius=0.1)))
+    assert faults.obstacles_pending
+    assert faults.due_obstacles(0.5) == []
+    assert len(faults.due_obstacles(1.0)) == 1 and faults.obstacles_pending
+    assert len(faults.due_obstacles(2.5)) == 1 and not faults.obstacles_pending
+    faults.reset()
+    assert faults.obstacles_pending
+
+
 def test_faults_from_the_world_file(tmp_path) -> None:
     path = tmp_path / "faulty.yaml"
     path.write_text("seed: 7\nfaults:\n  - {kind: dropout, start: 0.0, end: 0.25}\n"

@@ -102,3 +102,71 @@ def test_integration_of_an_arc() -> None:
     for _ in range(1000):  # a quarter turn of radius 1 m in 1000 steps
         odom.step(math.pi / 2, math.pi / 2, 0.001)
     assert odom.pose == pytest.approx((1.0, 1.0, math.pi / 2), abs=1e-6)
+
+
+def _per_step(commands: list[tuple[float, float]], dt: float) -> tuple[float, float, float]:
+    """The integration as it was, step by step (second-order Runge-Kutta)."""
+    x = y = theta = 0.0
+    for v, w in commands:
+        heading = theta + w * dt / 2
+        x += v * dt * math.cos(heading)
+        y += v * dt * math.sin(heading)
+        theta += w * dt
+    return x, y, math.atan2(math.sin(theta), math.cos(theta))
+
+
+def _drive() -> list[tuple[float, float]]:
+    """Ramps (a new velocity every step), long arcs, straight runs, turns on the spot."""
+    steps: list[tuple[float, float]] = [(0.01 * i, -0.02 * i) for i in range(40)]
+    steps += [(0.4, 0.7)] * 3000 + [(0.22, 0.0)] * 1500 + [(0.0, -1.3)] * 700
+    steps += [(-0.3, 2.8)] * 12000 + [(0.5, 1e-9)] * 400
+    steps += [(0.4 - 0.01 * i, 0.3) for i in range(40)]
+    return steps
+
+
+def test_runs_in_closed_form_equal_the_step_by_step_integration() -> None:
+    odom = WheelOdometry()
+    for v, w in _drive():
+        odom.step(v, w, 0.005)
+    assert odom.pose == pytest.approx(_per_step(_drive(), 0.005), rel=1e-9, abs=1e-9)
+
+
+def test_the_pose_does_not_depend_on_how_the_steps_came_nor_when_it_was_read() -> None:
+    one_by_one, in_runs = WheelOdometry(), WheelOdometry()
+    for v, w in _drive():
+        one_by_one.step(v, w, 0.005)
+        _ = one_by_one.pose
+    commands = _drive()
+    i = 0
+    while i < len(commands):
+        j = i
+        while j < len(commands) and commands[j] == commands[i] and j - i < 7:
+            j += 1
+        in_runs.run(*commands[i], 0.005, j - i)
+        i = j
+    assert in_runs.pose == one_by_one.pose  # bit for bit
+
+
+def test_the_simulation_odometry_equals_the_step_by_step_integration() -> None:
+    """The simulation hands the odometry runs of steps; every /odom sample is still the
+    step-by-step pose, and its velocities the ones driven in the last step."""
+    sim = Simulation(World(load_world("obstacles")))
+    x = y = theta = 0.0
+    dt = sim.world.dt
+    samples = 0
+    for i in range(3000):
+        if i % 600 == 0:
+            sim.world.set_command(0.3 + i / 10000, math.sin(i / 300))
+        out = sim.step()
+        v, w = sim.world.command
+        heading = theta + w * dt / 2
+        x, y, theta = x + v * dt * math.cos(heading), y + v * dt * math.sin(heading), theta + w * dt
+        expected = (x, y, math.atan2(math.sin(theta), math.cos(theta)))
+        if out.wheel_odom is not None:
+            samples += 1
+            wheel = out.wheel_odom
+            assert (wheel.x, wheel.y, wheel.theta) == pytest.approx(expected, rel=1e-9, abs=1e-9)
+            assert (wheel.v, wheel.w) == (v, w)
+        if i % 7 == 0:  # read between samples too: up to date with the last step
+            assert sim.odometry.pose == pytest.approx(expected, rel=1e-9, abs=1e-9)
+    assert samples == 750

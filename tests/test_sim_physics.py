@@ -99,3 +99,21 @@ def test_obstacle_added_at_run_time_blocks_the_robot() -> None:
     assert world.drain_contacts()[0].what.startswith("added circle")
     world.reset()
     assert len(world.geometry[1]) == 0  # run-time obstacles do not survive a reset
+
+
+def test_the_direct_chipmunk_step_equals_pymunks_space_step() -> None:
+    """The world steps Chipmunk without Space.step's Python when nothing is pending; the
+    public path (taken when pymunk's internals differ) gives the same trajectory."""
+    fast, public = World(load_world("obstacles")), World(load_world("obstacles"))
+    public._c_space = None
+    assert fast._c_space is not None
+    for world in (fast, public):
+        for i in range(1500):
+            if i % 300 == 0:
+                world.set_command(0.8 - i / 1000, 2 * math.sin(i / 200))
+            if i == 500:
+                world.add_obstacle(Circle(center=(3.0, 3.0), radius=0.2))
+            world.step()
+    assert fast.pose == public.pose
+    assert fast.velocity == public.velocity
+    assert fast.drain_contacts() == public.drain_contacts()
