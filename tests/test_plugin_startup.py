@@ -49,6 +49,7 @@ class Graph:
 class World:
     def __init__(self, graph: Graph) -> None:
         self.graph = graph
+        self.now = 12.5  # sim time: it stands still while the node starts
         self.holding = False
         self.held_while_waiting: list[bool] = []
 
@@ -108,6 +109,7 @@ def test_a_first_start_is_done_when_its_publishers_appear():
     node = start(graph, world, stale=set())
     assert len(world.held_while_waiting) == 3  # done on the look that found it
     assert node.startup_seconds is not None
+    assert node.appeared_at == 12.5  # its timers began then (timer_sync's run counts from it)
     assert all(world.held_while_waiting) and not world.holding
 
 
