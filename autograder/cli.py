@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 import shutil
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 import click
@@ -208,10 +209,14 @@ _domain = click.option("--domain", type=click.IntRange(0, 232), default=None,
                        help="ROS domain id (default: a free one, reserved for the run).")
 
 
-class _ModuleJobsType(click.ParamType):
-    """``--module-jobs``: test modules run at once in one grading (1 to 64), or ``auto``."""
+class _CountOrAuto(click.ParamType):
+    """``--jobs``, ``--module-jobs``: a number of things at once (1 to 64), or ``auto``;
+    ``error`` gives the message for anything else (a function: translated when used)."""
 
     name = "N|auto"
+
+    def __init__(self, error: Callable[[], str]) -> None:
+        self._error = error
 
     def convert(self, value, param, ctx):  # noqa: ANN001, ANN201
         if isinstance(value, int) or value == "auto":
@@ -221,13 +226,17 @@ class _ModuleJobsType(click.ParamType):
         except ValueError:
             jobs = 0
         if not 1 <= jobs <= 64:
-            self.fail(_("--module-jobs must be a number from 1 to 64 or auto, got {value}"
-                        ).format(value=value), param, ctx)
+            self.fail(self._error().format(value=value), param, ctx)
         return jobs
 
 
+_MODULE_JOBS = _CountOrAuto(
+    lambda: _("--module-jobs must be a number from 1 to 64 or auto, got {value}"))
+_JOBS = _CountOrAuto(lambda: _("--jobs must be a number from 1 to 64 or auto, got {value}"))
+
+
 _module_jobs = click.option(
-    "--module-jobs", type=_ModuleJobsType(), default="auto", show_default=True,
+    "--module-jobs", type=_MODULE_JOBS, default="auto", show_default=True,
     help="Test modules run at the same time within the grading, each in a child of its "
          "own on its own ROS domain; 'auto': one per module as far as the cores go. "
          "--domain means 1.")
@@ -300,28 +309,12 @@ def bundle_gradescope(exercise: str, zip_path: Path) -> None:
     click.echo(_("Gradescope autograder written to {path}").format(path=zip_path))
 
 
-class _JobsType(click.ParamType):
-    """``--jobs``: a number of gradings at once (1 to 64), or ``auto``."""
-
-    name = "N|auto"
-
-    def convert(self, value, param, ctx):  # noqa: ANN001, ANN201
-        if isinstance(value, int) or value == "auto":
-            return value
-        try:
-            jobs = int(value)
-        except ValueError:
-            jobs = 0
-        if not 1 <= jobs <= 64:
-            self.fail(_("--jobs must be a number from 1 to 64 or auto, got {value}").format(
-                value=value), param, ctx)
-        return jobs
 
 
 @main.command("grade-batch")
 @click.argument("item", metavar="EXERCISE_OR_QUIZ")
 @click.argument("submissions", type=click.Path(path_type=Path, file_okay=False, exists=True))
-@click.option("--jobs", type=_JobsType(), default="1", show_default=True,
+@click.option("--jobs", type=_JOBS, default="1", show_default=True,
               help="Gradings run at the same time (each on its own ROS domain), or 'auto': "
                    "grade the first student alone and choose from its CPU use and the "
                    "machine's cores and memory.")
@@ -333,7 +326,7 @@ class _JobsType(click.ParamType):
               help="Grade only share I of N (stable: by a hash of the student's name).")
 @click.option("--record", type=click.Path(path_type=Path, file_okay=False), default=None,
               help="Record each student's grading as rosbag2 bags (MCAP) in RECORD/<student>.")
-@click.option("--module-jobs", type=_ModuleJobsType(), default=None,
+@click.option("--module-jobs", type=_MODULE_JOBS, default=None,
               help="Test modules run at the same time within each grading (default: auto "
                    "with --jobs 1, else 1: the gradings share the cores).")
 @_lang_option
