@@ -28,6 +28,17 @@ processes, in milliseconds.
   wall-time cap alone, tried first, let sim time run on while a starved process waited
   for a CPU, and a correct node then failed under load.)  How each hold ended is counted
   (:attr:`Pacer.counts`; the results file's ``pacing``).
+* **CPU reserve.**  A process that is usually idle may take a longer turn now and then:
+  each watched process has a reserve of up to ``cpu_reserve`` (2 s) of CPU, on top of
+  ``cpu_budget``, that a tick's hold draws on once the budget is used; a tick in which it
+  uses less than the budget pays the difference back.  Jazzy's MultiThreadedExecutor (in
+  rclpy 7.1.6, the PyPI wheel; rclpy issue 1452) re-submits a callback to its thread pool
+  while no worker has started it, so on a loaded machine a correct node can burn a few
+  hundred ms of CPU before its 10 Hz timer's callback runs.  A budget alone then let the
+  tick go on without it (seen in CI: eight gradings on two cores, a beat lost).  A process
+  that always computes empties its reserve once and then gets exactly ``cpu_budget`` a
+  tick, so a busy loop slows the world no more than before.  Holds that drew on the
+  reserve are counted (:attr:`Pacer.bursts`).
 * **Heard first.**  Idle only counts once the process has *heard* the tick: its CPU time
   has grown since just before the tick went out (:meth:`Pacer.about_to_publish`), or it
   is running.  On a loaded machine the kernel may hand a loopback datagram to the
@@ -57,7 +68,7 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from typing import Literal, Protocol
 
-from sim.procstate import ProcessReader, read_process_state
+from sim.procstate import ProcessReader, ProcessState, read_process_state
 
 DEFAULT_CLOCK_HZ = 20.0
 """Most ``/clock`` messages per wall second; see the module's docstring for why 20."""
@@ -112,6 +123,8 @@ class PacingPolicy:
     once would often find them idle only because the messages had not reached them."""
     hear_timeout: float = 0.5
     """Longest wait, from the tick's publication, for a watched process to hear it."""
+    cpu_reserve: float = 2.0
+    """Most CPU seconds a watched process may bank, beyond ``cpu_budget``, for a burst."""
     poll_interval: float = 0.0005
     max_tick: float = 2.0
     """Longest tick at RTF 0, in sim seconds."""
@@ -119,6 +132,8 @@ class PacingPolicy:
     def __post_init__(self) -> None:
         if self.clock_hz <= 0:
             raise ValueError("clock_hz must be > 0")
+        if self.cpu_budget < 0 or self.cpu_reserve < 0:
+            raise ValueError("cpu_budget and cpu_reserve must be >= 0")
 
 
 @dataclass(frozen=True)
@@ -165,6 +180,9 @@ class Pacer:
         self.held_seconds = 0.0
         # Ticks held because a process was idle but had not heard the tick yet.
         self.late_deliveries = 0
+        # Holds in which a process used more than cpu_budget, drawing on its reserve.
+        self.bursts = 0
+        self._reserve: dict[int, float] = {}  # CPU seconds each watched process has banked
         self._before: dict[int, int] = {}  # CPU ns of each watched process before a tick
         self._heard: set[int] = set()  # those seen to hear the last tick during its hold
         self._listening: set[int] = set()  # those that heard the tick before
@@ -223,10 +241,12 @@ class Pacer:
                 self._pids.clear()
                 self._listening.clear()
                 self._closing.clear()
+                self._reserve.clear()
             else:
                 self._pids.add(pid)
                 self._listening.add(pid)
                 self._closing.discard(pid)
+                self._reserve.setdefault(pid, self.policy.cpu_reserve)
             self._window.clear()
 
     def unwatch(self, pid: int) -> None:
@@ -234,6 +254,7 @@ class Pacer:
             self._pids.discard(pid)
             self._listening.discard(pid)
             self._closing.discard(pid)
+            self._reserve.pop(pid, None)
 
     def closing(self, pid: int) -> None:
         """Process ``pid`` is being stopped: hold ticks while it has work, as before, but
@@ -336,13 +357,15 @@ class Pacer:
         CPU share, or the cap.
 
         A process that keeps computing is let go once it has used ``cpu_budget`` seconds of
-        CPU since the tick (it is busy, not slow); one that is runnable but gets no CPU (a
-        busy machine) holds the world back, up to ``hold_cap`` of wall time; one that is
-        idle but has not heard the tick is waited for up to ``hear_timeout``.
+        CPU since the tick and whatever it has in reserve (it is busy, not slow); one that
+        is runnable but gets no CPU (a busy machine) holds the world back, up to
+        ``hold_cap`` of wall time; one that is idle but has not heard the tick is waited for
+        up to ``hear_timeout``.
         """
         with self.condition:
             pids = tuple(self._pids)
             before, listening = dict(self._before), set(self._listening)
+            reserve = {pid: self._reserve.get(pid, self.policy.cpu_reserve) for pid in pids}
         if not pids:
             self.counts["free"] += 1
             return
@@ -357,16 +380,18 @@ class Pacer:
                     for pid in pids}
         heard = {pid: pid not in before for pid in pids}
         budget_ns = int(policy.cpu_budget * 1e9)
+        share_ns = {pid: budget_ns + int(reserve[pid] * 1e9) for pid in pids}
         cap = published + policy.hold_cap
         deafness = published + policy.hear_timeout
         outcome: HoldOutcome = "cap"
         late = False
+        states: dict[int, ProcessState] = {}
         while (now := clock.monotonic()) < cap:
             states = {pid: self._read(pid) for pid in pids}
             for pid, state in states.items():
                 heard[pid] = heard[pid] or (not state.exists or state.busy
                                             or state.cpu_ns > baseline[pid])
-            working = any(state.busy and state.cpu_ns - baseline[pid] < budget_ns
+            working = any(state.busy and state.cpu_ns - baseline[pid] < share_ns[pid]
                           for pid, state in states.items())
             waiting = [pid for pid in listening if pid in heard and not heard[pid]]
             if not working and waiting and now >= deafness:
@@ -377,8 +402,16 @@ class Pacer:
                 break
             late = late or not working
             clock.sleep(policy.poll_interval)
+        burst = False
         with self.condition:
             self._heard = {pid for pid, yes in heard.items() if yes}
+            for pid, state in states.items():
+                used_ns = max(0, state.cpu_ns - baseline[pid])
+                burst = burst or used_ns > budget_ns
+                if pid in self._reserve:  # not unwatched meanwhile
+                    self._reserve[pid] = min(policy.cpu_reserve, max(
+                        0.0, reserve[pid] + (budget_ns - used_ns) / 1e9))
+        self.bursts += burst
         self.counts[outcome] += 1
         if late and outcome != "unheard":
             self.late_deliveries += 1

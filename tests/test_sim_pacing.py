@@ -6,6 +6,7 @@ times the ticks went at, the sim time they made, and how the holds ended.
 
 from __future__ import annotations
 
+import collections
 import math
 import threading
 from collections.abc import Callable
@@ -176,16 +177,93 @@ def test_hold_ends_when_the_process_is_idle() -> None:
 
 @pytest.mark.parametrize("share,hold", [(1.0, 0.05), (0.5, 0.1), (0.25, 0.2)])
 def test_hold_ends_when_the_cpu_budget_is_used(share: float, hold: float) -> None:
-    """A busy process is let go after cpu_budget (50 ms) of CPU, whatever its share."""
+    """A busy process is let go after cpu_budget (50 ms) of CPU, whatever its share (here
+    without a reserve: see the reserve's tests below)."""
     clock = FakeClock()
-    run = Run(Pacer(DT, 1.0, clock=clock, read_process=FakeProcess(clock, cpu_share=share)),
-              clock)
+    run = Run(Pacer(DT, 1.0, PacingPolicy(cpu_reserve=0.0), clock=clock,
+                    read_process=FakeProcess(clock, cpu_share=share)), clock)
     run.pacer.watch(4242)
     run.ticks_for(5)
     assert run.pacer.counts == {"budget": 5}
     # settle (1 ms), then the budget's worth of CPU at this share
     assert run.pacer.longest_hold == pytest.approx(0.001 + hold, abs=0.001)
     assert all(gap == pytest.approx(max(0.05, 0.001 + hold), abs=0.001) for gap in run.gaps())
+
+
+@dataclass
+class Bursts:
+    """A process that reacts to each tick for 1 ms and computes, at a whole CPU, during
+    the given spans of wall time (a callback that now and then takes long)."""
+
+    clock: FakeClock
+    spans: list[tuple[float, float]] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        self.ticks = FakeProcess(self.clock, idle_at=self.clock.now, reaction=0.001)
+
+    def burst(self, seconds: float) -> None:
+        """Compute for ``seconds`` from now."""
+        self.spans.append((self.clock.now, self.clock.now + seconds))
+
+    def __call__(self, pid: int) -> ProcessState:
+        now, state = self.clock.now, self.ticks(pid)
+        computed = sum(min(now, end) - start for start, end in self.spans if now > start)
+        busy = state.busy or any(start <= now < end for start, end in self.spans)
+        return ProcessState(busy=busy, cpu_ns=state.cpu_ns + round(computed * 1e9))
+
+
+def test_a_burst_is_waited_for_from_the_reserve() -> None:
+    """A usually idle process that computes for 0.3 s of CPU after a tick (a thread pool
+    catching up) holds that tick until it is done; without a reserve the tick went on
+    after its 50 ms budget."""
+    for reserve, outcome, hold in ((2.0, "idle", 0.3), (0.0, "budget", 0.05)):
+        clock = FakeClock()
+        process = Bursts(clock)
+        run = Run(Pacer(DT, 1.0, PacingPolicy(cpu_reserve=reserve), clock=clock,
+                        read_process=process), clock)
+        run.pacer.watch(4242)
+        run.ticks_for(3)
+        process.burst(0.3)
+        run.tick()
+        assert run.pacer.counts == collections.Counter(["idle"] * 3 + [outcome])
+        assert run.pacer.longest_hold == pytest.approx(hold, abs=0.002)
+        assert run.pacer.bursts == 1
+
+
+def test_the_reserve_is_paid_back_while_idle() -> None:
+    """A burst spends the reserve; ticks that use less than the budget pay it back, up to
+    cpu_reserve, so a later burst is waited for again."""
+    clock = FakeClock()
+    process = Bursts(clock)
+    run = Run(Pacer(DT, 1.0, PacingPolicy(cpu_reserve=0.5), clock=clock,
+                    read_process=process), clock)
+    run.pacer.watch(4242)
+    run.tick()
+    process.burst(0.5)
+    run.tick()  # 0.5 s: the budget and 0.45 s of the reserve
+    assert run.pacer.counts == {"idle": 2}
+    process.burst(0.5)
+    run.tick()  # 0.05 s of reserve left: the tick goes on after 0.1 s
+    assert run.pacer.counts == {"idle": 2, "budget": 1}
+    clock.sleep(0.5)  # the burst ends
+    run.ticks_for(12)  # each pays back 49 ms: full again
+    process.burst(0.5)
+    run.tick()
+    assert run.pacer.counts == {"idle": 15, "budget": 1}
+    assert run.pacer.bursts == 3
+
+
+def test_a_busy_loop_spends_its_reserve_once() -> None:
+    """A process that always computes gets budget and reserve at the first tick, then
+    exactly cpu_budget a tick: the reserve does not slow the world for busy loops."""
+    clock = FakeClock()
+    run = Run(Pacer(DT, 1.0, PacingPolicy(cpu_reserve=0.5), clock=clock,
+                    read_process=FakeProcess(clock)), clock)
+    run.pacer.watch(4242)
+    run.ticks_for(6)
+    assert run.pacer.counts == {"budget": 6}
+    assert run.gaps()[0] == pytest.approx(0.001 + 0.55, abs=0.002)
+    assert run.gaps()[1:] == pytest.approx([0.051] * 4, abs=0.002)
 
 
 def test_a_starved_process_holds_until_the_cap() -> None:
@@ -219,8 +297,8 @@ def test_every_watched_process_must_be_done() -> None:
     clock = FakeClock()
     idle_soon, computing = FakeProcess(clock, idle_at=clock.now), FakeProcess(clock)
     processes = {1: idle_soon, 2: computing}
-    run = Run(Pacer(DT, 1.0, clock=clock, read_process=lambda pid: processes[pid](pid)),
-              clock)
+    run = Run(Pacer(DT, 1.0, PacingPolicy(cpu_reserve=0.0), clock=clock,
+                    read_process=lambda pid: processes[pid](pid)), clock)
     run.pacer.watch(1)
     run.pacer.watch(2)
     run.tick()
@@ -296,7 +374,8 @@ def test_a_process_being_stopped_is_not_waited_for_to_hear() -> None:
     """Once the grader stops a node, it stops hearing ticks: no hear_timeout for that."""
     clock = FakeClock()
     process = FakeProcess(clock, idle_at=clock.now, reaction=0.01)
-    run = Run(Pacer(DT, 1.0, clock=clock, read_process=process), clock)
+    run = Run(Pacer(DT, 1.0, PacingPolicy(cpu_reserve=0.0), clock=clock,
+                    read_process=process), clock)
     run.pacer.watch(4242)
     run.ticks_for(2)
     run.pacer.closing(4242)

@@ -64,8 +64,9 @@ class Exercise:
         "sim-time timer exact at 20 Hz but stutters from about 50 Hz (measured)."))
     cpu_budget: float = dataclasses.field(default=DEFAULT_CPU_BUDGET, metadata=_doc(
         "CPU seconds the student's process may use after a clock tick before the world "
-        "moves on without it. Jazzy's MultiThreadedExecutor can spin for 50-250 ms of CPU "
-        "while it hands callbacks to its threads (rclpy issue 1452): raise this for "
+        "moves on without it, beyond which it draws on a reserve of up to 2 s that ticks "
+        "it spends idle pay back. Jazzy's MultiThreadedExecutor can spin for 50-250 ms of "
+        "CPU while it hands callbacks to its threads (rclpy issue 1452): raise this for "
         "multi-threaded nodes; a busy loop then slows the world by this much per tick."))
     startup_timeout: float = dataclasses.field(default=20.0, metadata=_doc(
         "Wall seconds the node has to appear on the ROS graph after its process starts."))

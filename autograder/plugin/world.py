@@ -110,7 +110,8 @@ def world(request: pytest.FixtureRequest, exercise: Exercise,
             reporter.data.setdefault("pacing", {})[request.node.name] = {
                 **bridge.pacing, "longest_hold": round(bridge.longest_hold, 3),
                 "held_seconds": round(bridge.pacer.held_seconds, 3),
-                "late_deliveries": bridge.pacer.late_deliveries}
+                "late_deliveries": bridge.pacer.late_deliveries,
+                "bursts": bridge.pacer.bursts}
 
 
 def _timing(request: pytest.FixtureRequest) -> Timing:
