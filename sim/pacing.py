@@ -29,16 +29,16 @@ processes, in milliseconds.
   for a CPU, and a correct node then failed under load.)  How each hold ended is counted
   (:attr:`Pacer.counts`; the results file's ``pacing``).
 * **CPU reserve.**  A process that is usually idle may take a longer turn now and then:
-  each watched process has a reserve of up to ``cpu_reserve`` (2 s) of CPU, on top of
-  ``cpu_budget``, that a tick's hold draws on once the budget is used; a tick in which it
-  uses less than the budget pays the difference back.  Jazzy's MultiThreadedExecutor (in
-  rclpy 7.1.6, the PyPI wheel; rclpy issue 1452) re-submits a callback to its thread pool
-  while no worker has started it, so on a loaded machine a correct node can burn a few
-  hundred ms of CPU before its 10 Hz timer's callback runs.  A budget alone then let the
-  tick go on without it (seen in CI: eight gradings on two cores, a beat lost).  A process
-  that always computes empties its reserve once and then gets exactly ``cpu_budget`` a
-  tick, so a busy loop slows the world no more than before.  Holds that drew on the
-  reserve are counted (:attr:`Pacer.bursts`).
+  each watched process banks, up to ``cpu_reserve`` (2 s), the part of ``cpu_budget`` it
+  leaves unused in each tick, and a tick's hold draws on that bank once the budget is
+  used.  It starts empty, so a process that computes from the start never has one.
+  Jazzy's MultiThreadedExecutor (rclpy 7.1.6, the PyPI wheel; rclpy issue 1452) loops on
+  a ready callback, handing it to its thread pool again, until a worker starts it: on a
+  loaded machine a correct node's main thread burnt 220-240 ms of CPU in one tick while
+  timer_sync's planner slept.  A budget alone then let the tick go on without it (seen in
+  CI: eight gradings on two cores, a beat lost).  A process that always computes gets
+  exactly ``cpu_budget`` a tick, so a busy loop slows the world no more than before.
+  Holds that drew on the reserve are counted (:attr:`Pacer.bursts`).
 * **Heard first.**  Idle only counts once the process has *heard* the tick: its CPU time
   has grown since just before the tick went out (:meth:`Pacer.about_to_publish`), or it
   is running.  On a loaded machine the kernel may hand a loopback datagram to the
@@ -246,7 +246,7 @@ class Pacer:
                 self._pids.add(pid)
                 self._listening.add(pid)
                 self._closing.discard(pid)
-                self._reserve.setdefault(pid, self.policy.cpu_reserve)
+                self._reserve.setdefault(pid, 0.0)
             self._window.clear()
 
     def unwatch(self, pid: int) -> None:
@@ -365,7 +365,7 @@ class Pacer:
         with self.condition:
             pids = tuple(self._pids)
             before, listening = dict(self._before), set(self._listening)
-            reserve = {pid: self._reserve.get(pid, self.policy.cpu_reserve) for pid in pids}
+            reserve = {pid: self._reserve.get(pid, 0.0) for pid in pids}
         if not pids:
             self.counts["free"] += 1
             return
@@ -407,7 +407,7 @@ class Pacer:
             self._heard = {pid for pid, yes in heard.items() if yes}
             for pid, state in states.items():
                 used_ns = max(0, state.cpu_ns - baseline[pid])
-                burst = burst or used_ns > budget_ns
+                burst = burst or (used_ns > budget_ns and reserve[pid] > 0)
                 if pid in self._reserve:  # not unwatched meanwhile
                     self._reserve[pid] = min(policy.cpu_reserve, max(
                         0.0, reserve[pid] + (budget_ns - used_ns) / 1e9))

@@ -214,56 +214,59 @@ class Bursts:
 
 def test_a_burst_is_waited_for_from_the_reserve() -> None:
     """A usually idle process that computes for 0.3 s of CPU after a tick (a thread pool
-    catching up) holds that tick until it is done; without a reserve the tick went on
-    after its 50 ms budget."""
+    catching up) holds that tick until it is done, once its idle ticks have banked enough
+    (49 ms each here); without a reserve the tick went on after its 50 ms budget."""
     for reserve, outcome, hold in ((2.0, "idle", 0.3), (0.0, "budget", 0.05)):
         clock = FakeClock()
         process = Bursts(clock)
         run = Run(Pacer(DT, 1.0, PacingPolicy(cpu_reserve=reserve), clock=clock,
                         read_process=process), clock)
         run.pacer.watch(4242)
-        run.ticks_for(3)
+        run.ticks_for(6)
         process.burst(0.3)
         run.tick()
-        assert run.pacer.counts == collections.Counter(["idle"] * 3 + [outcome])
+        assert run.pacer.counts == collections.Counter(["idle"] * 6 + [outcome])
         assert run.pacer.longest_hold == pytest.approx(hold, abs=0.002)
-        assert run.pacer.bursts == 1
+        assert run.pacer.bursts == (1 if reserve else 0)
 
 
 def test_the_reserve_is_paid_back_while_idle() -> None:
-    """A burst spends the reserve; ticks that use less than the budget pay it back, up to
-    cpu_reserve, so a later burst is waited for again."""
+    """The reserve starts empty and fills from ticks that use less than the budget, up to
+    cpu_reserve; a burst spends it, and a later burst is waited for once it is paid back."""
     clock = FakeClock()
     process = Bursts(clock)
     run = Run(Pacer(DT, 1.0, PacingPolicy(cpu_reserve=0.5), clock=clock,
                     read_process=process), clock)
     run.pacer.watch(4242)
-    run.tick()
+    process.burst(0.5)
+    run.tick()  # nothing banked yet: the tick goes on after the budget
+    assert run.pacer.counts == {"budget": 1}
+    clock.sleep(0.5)  # the burst ends
+    run.ticks_for(12)  # each banks 49 ms: 0.5 s, full
     process.burst(0.5)
     run.tick()  # 0.5 s: the budget and 0.45 s of the reserve
-    assert run.pacer.counts == {"idle": 2}
+    assert run.pacer.counts == {"budget": 1, "idle": 13}
     process.burst(0.5)
     run.tick()  # 0.05 s of reserve left: the tick goes on after 0.1 s
-    assert run.pacer.counts == {"idle": 2, "budget": 1}
-    clock.sleep(0.5)  # the burst ends
-    run.ticks_for(12)  # each pays back 49 ms: full again
+    assert run.pacer.counts == {"budget": 2, "idle": 13}
+    clock.sleep(0.5)
+    run.ticks_for(12)
     process.burst(0.5)
     run.tick()
-    assert run.pacer.counts == {"idle": 15, "budget": 1}
-    assert run.pacer.bursts == 3
+    assert run.pacer.counts == {"budget": 2, "idle": 26}
+    assert run.pacer.bursts == 3  # the first burst had nothing to draw on
 
 
-def test_a_busy_loop_spends_its_reserve_once() -> None:
-    """A process that always computes gets budget and reserve at the first tick, then
-    exactly cpu_budget a tick: the reserve does not slow the world for busy loops."""
+def test_a_busy_loop_has_no_reserve() -> None:
+    """A process that always computes banks nothing: exactly cpu_budget a tick, so the
+    reserve does not slow the world for busy loops."""
     clock = FakeClock()
-    run = Run(Pacer(DT, 1.0, PacingPolicy(cpu_reserve=0.5), clock=clock,
-                    read_process=FakeProcess(clock)), clock)
+    run = Run(Pacer(DT, 1.0, clock=clock, read_process=FakeProcess(clock)), clock)
     run.pacer.watch(4242)
     run.ticks_for(6)
     assert run.pacer.counts == {"budget": 6}
-    assert run.gaps()[0] == pytest.approx(0.001 + 0.55, abs=0.002)
-    assert run.gaps()[1:] == pytest.approx([0.051] * 4, abs=0.002)
+    assert run.gaps() == pytest.approx([0.051] * 5, abs=0.002)
+    assert run.pacer.bursts == 0
 
 
 def test_a_starved_process_holds_until_the_cap() -> None:
