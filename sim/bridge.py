@@ -87,6 +87,10 @@ class SimBridge:
         self._clock_log: list[tuple[int, float]] = []
         self._threads: list[threading.Thread] = []
         self._taps: list[Callable[[str, str, Any, float], None]] = []
+        # Pace changes due at a sim time (schedule_real_time_factor), soonest first, and
+        # those made so far as (sim time, rtf).
+        self._pace_due: list[tuple[float, float]] = []
+        self.pace_changes: list[tuple[float, float]] = []
         self.node = Node(node_name, context=context)
         qos = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
         self._clock_pub = self.node.create_publisher(Clock, "/clock", qos)
@@ -152,6 +156,31 @@ class SimBridge:
     def set_real_time_factor(self, rtf: float) -> None:
         """Sim seconds per wall second; 0 runs as fast as the graph keeps up."""
         self.pacer.set_real_time_factor(rtf)
+
+    def schedule_real_time_factor(self, at: float, rtf: float) -> None:
+        """Run at ``rtf`` from the first tick that starts at or after sim time ``at``.
+
+        The world makes the change itself, so it lands on that sim time however late the
+        caller's thread runs (on a loaded machine a grader waiting for the moment may wake
+        a few ticks after it).  Each change made is logged in :attr:`pace_changes`.
+        """
+        if rtf < 0:
+            raise ValueError("real_time_factor must be >= 0")
+        with self._cond:
+            self._pace_due.append((at, rtf))
+            self._pace_due.sort(key=lambda due: due[0])
+
+    def cancel_scheduled_pace(self) -> None:
+        """Drop the pace changes not made yet."""
+        with self._cond:
+            self._pace_due.clear()
+
+    def _make_due_pace_changes(self) -> None:
+        now = self.world.time
+        while self._pace_due and self._pace_due[0][0] <= now + 1e-9:
+            _at, rtf = self._pace_due.pop(0)
+            self.pacer.set_real_time_factor(rtf)
+            self.pace_changes.append((now, rtf))
 
     def inject(self, fault: Fault) -> None:
         """Add a fault at run time."""
@@ -279,6 +308,7 @@ class SimBridge:
     def _run(self) -> None:
         while True:
             with self._cond:
+                self._make_due_pace_changes()
                 tick = self.pacer.next_tick()
                 if tick is None:
                     return

@@ -21,7 +21,7 @@ from autograder.render.html import to_html
 pytestmark = pytest.mark.slow
 
 # The submissions and what each must lose: tests/submissions/timer_sync/*/.
-# Gradings here wait on simulation time at real-time pace, not on the CPU: seven at a
+# Gradings here wait on simulation time (at twice real time), not on the CPU: seven at a
 # time, two waves for the fourteen (measured: six in parallel beside a busy loop kept
 # every 10 Hz beat, and seven at a time passed this proof).
 PROOF = Proof("timer_sync", jobs=7)
@@ -82,7 +82,7 @@ def test_report_plots_the_intervals_each_rate_test_measured(graded):
     (control,) = charts["test_control_rate"]
     assert control["title"] == "cmd_vel"
     assert control["limit"] == pytest.approx(0.15)  # the largest gap allowed
-    assert len(control["points"]) > 180  # 23 s at 10 Hz, less what discovery took
+    assert len(control["points"]) > 180  # 22 s at 10 Hz, less what discovery took
     assert all(gap <= control["limit"] for _t, gap in control["points"])  # the reference keeps it
     assert len(charts["test_control_while_planning"]) >= 2  # one per planner run
     for name in ("test_status_rate", "test_plan_rate", "test_rates_at_half_speed"):

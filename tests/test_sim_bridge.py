@@ -165,6 +165,30 @@ def test_waits_are_told_to_on_wait(graph: tuple[SimBridge, Probe]) -> None:
     assert all(seconds >= 0 and held == 0 for seconds, held in told)
 
 
+def test_scheduled_pace_lands_on_its_sim_time(graph: tuple[SimBridge, Probe]) -> None:
+    """A pace change scheduled for a sim time is made by the world at the first tick from
+    that time, not when the caller's thread next looks; cancelled ones are not made."""
+    bridge, _probe = graph
+    pace, tick = bridge.real_time_factor, 2.0 / 50.0  # this world's tick, in sim seconds
+    start = bridge.now
+    bridge.schedule_real_time_factor(start + 0.5, 1.0)
+    bridge.schedule_real_time_factor(start + 0.3, 0.5)  # out of order: made first
+    bridge.schedule_real_time_factor(start + 5.0, 3.0)
+    try:
+        assert bridge.wait_until(start + 0.6, wall_timeout=WALL)
+        made = [(t, rtf) for t, rtf in bridge.pace_changes if t >= start]
+        assert [rtf for _t, rtf in made] == [0.5, 1.0]
+        for (t, _rtf), at in zip(made, (start + 0.3, start + 0.5), strict=True):
+            # At the tick from `at` on (its length: 0.04 s at RTF 2, 0.01 s at 0.5).
+            assert at - 1e-9 <= t < at + tick
+        assert bridge.real_time_factor == 1.0
+        bridge.cancel_scheduled_pace()
+    finally:
+        bridge.cancel_scheduled_pace()
+        bridge.set_real_time_factor(pace)
+    assert [rtf for t, rtf in bridge.pace_changes if t >= start] == [0.5, 1.0]
+
+
 def _rtf_over(bridge: SimBridge, sim_seconds: float) -> float:
     """Measured RTF over the next ``sim_seconds`` of sim time."""
     assert bridge.wait_until(bridge.now + 0.1, wall_timeout=WALL)  # fresh window
