@@ -13,12 +13,19 @@ import sysconfig
 import tempfile
 from collections.abc import Iterator
 from pathlib import Path
+from xml.etree import ElementTree
 
 import pytest
 
 from autograder.core.exercise import Limits
 from autograder.grading.run import GRADER_FAULT
-from autograder.sandbox.isolation import detect
+from autograder.sandbox.isolation import (
+    FASTDDS_PROFILE,
+    PROFILE_ENV,
+    Isolation,
+    dds_env,
+    detect,
+)
 from autograder.sandbox.process import LaunchFailed, student_process
 
 REPO = Path(__file__).resolve().parent.parent
@@ -53,6 +60,35 @@ def test_a_program_that_fails_at_once_is_the_programs_failure(tmp_path):
     assert process.wait(30) == 1
     process.stop()
     assert "mine" in process.output_text()
+
+
+def test_the_program_gets_the_runs_fast_dds_profile_in_its_own_folder(tmp_path):
+    """The student's program reads the run's Fast DDS profile from a copy in its working
+    directory (in strict isolation the grader's package is hidden from it)."""
+    shown = ("import os, pathlib\n"
+             f"path = pathlib.Path(os.environ[{PROFILE_ENV!r}])\n"
+             "print(path.parent == pathlib.Path.cwd(), path.read_text())\n")
+    process = student_process(_program(tmp_path, shown), [], Limits(), domain=0,
+                              strict=False, course=COURSE)
+    process.start()
+    assert process.wait(30) == 0
+    process.stop()
+    assert process.output_text().startswith("True ")
+    assert FASTDDS_PROFILE.read_text() in process.output_text()
+
+
+def test_the_fast_dds_profile_announces_participants_often():
+    """The profile is Fast DDS XML whose default participant announces itself every 0.25 s
+    and 20 times at the start (the file says why), and every process of a run gets it."""
+    ns = {"f": "http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles"}
+    root = ElementTree.parse(FASTDDS_PROFILE).getroot()
+    participant = root.find("f:participant[@is_default_profile='true']", ns)
+    assert participant is not None
+    discovery = participant.find("f:rtps/f:builtin/f:discovery_config", ns)
+    assert discovery.findtext("f:leaseAnnouncement/f:nanosec", namespaces=ns) == "250000000"
+    assert discovery.findtext("f:initialAnnouncements/f:count", namespaces=ns) == "20"
+    for strict in (False, True):
+        assert dds_env(Isolation(strict))[PROFILE_ENV] == str(FASTDDS_PROFILE)
 
 
 @pytest.mark.slow

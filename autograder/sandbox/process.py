@@ -35,6 +35,10 @@ _PASS_THROUGH = (
 )
 
 
+STUDENT_PROFILE = ".fastdds_profile.xml"
+"""The name of the student's copy of the Fast DDS profile in its working directory."""
+
+
 def student_process(script: Path, ros_args: list[str], limits: Limits, *, domain: int,
                     strict: bool, course: Path) -> StudentProcess:
     """The student's program as every launch prepares it: a copy of ``script`` and its
@@ -44,7 +48,14 @@ def student_process(script: Path, ros_args: list[str], limits: Limits, *, domain
     The grading (``autograder.plugin.launch``) and strict isolation's start-up check
     (``autograder.sandbox.isolation``) both start programs through here, so the check proves what
     a real launch does."""
-    from autograder.sandbox.isolation import Isolation, dds_env, protected_paths, student_uid
+    from autograder.sandbox.isolation import (
+        FASTDDS_PROFILE,
+        PROFILE_ENV,
+        Isolation,
+        dds_env,
+        protected_paths,
+        student_uid,
+    )
 
     # Strict: a folder outside the grader's (0700) run folder, turned into the student's
     # own tmpfs by the launcher. Basic: a throwaway folder beside the staged copy.
@@ -52,7 +63,10 @@ def student_process(script: Path, ros_args: list[str], limits: Limits, *, domain
                                     dir=None if strict else script.parent.parent))
     for source in script.parent.glob("*.py"):
         (workdir / source.name).write_bytes(source.read_bytes())
-    env = minimal_env(workdir, {"ROS_DOMAIN_ID": str(domain), **dds_env(Isolation(strict))})
+    profile = workdir / STUDENT_PROFILE
+    profile.write_bytes(FASTDDS_PROFILE.read_bytes())
+    env = minimal_env(workdir, {"ROS_DOMAIN_ID": str(domain), **dds_env(Isolation(strict)),
+                                PROFILE_ENV: str(profile)})
     process = StudentProcess(workdir / script.name, workdir, ros_args, env, limits)
     if strict:
         process.uid = student_uid(domain)
