@@ -46,10 +46,35 @@ def apply_limits(limits: dict[str, int]) -> None:
         if key not in limits:
             continue
         value = int(limits[key]) * scale
-        if which == resource.RLIMIT_NPROC and os.geteuid() == 0 and "uid" not in limits:
-            continue  # root is exempt from RLIMIT_NPROC; the pids cgroup counts instead
+        if which == resource.RLIMIT_NPROC and "uid" not in limits:
+            if os.geteuid() == 0:
+                continue  # root is exempt from RLIMIT_NPROC; the pids cgroup counts instead
+            # Without a uid of its own the student shares the grader's user, and
+            # RLIMIT_NPROC counts every thread that user runs: the grader's children and
+            # their other students too (four module children at once left a reference
+            # solution unable to start a thread). Allow ``processes`` beyond those.
+            value += user_tasks(os.getuid())
+            hard = resource.getrlimit(which)[1]
+            if hard != resource.RLIM_INFINITY:
+                value = min(value, hard)
         resource.setrlimit(which, (value, value))
     resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
+
+
+def user_tasks(uid: int, proc: str = "/proc") -> int:
+    """Processes and threads whose real user is ``uid`` now: what RLIMIT_NPROC counts."""
+    total = 0
+    for name in os.listdir(proc):
+        if not name.isdigit():
+            continue
+        try:
+            with open(f"{proc}/{name}/status", "rb") as fh:
+                fields = dict(line.split(b":", 1) for line in fh if b":" in line)
+            if int(fields[b"Uid"].split()[0]) == uid:
+                total += int(fields[b"Threads"])
+        except (OSError, KeyError, ValueError, IndexError):
+            continue  # gone meanwhile, or a kernel thread's short status
+    return total
 
 
 def _libc() -> ctypes.CDLL:
