@@ -4,6 +4,11 @@ ticks went on (student idle, CPU share used, wall cap hit: see sim/bridge.py); t
 the seconds went (the results file's ``timing``, summed over test modules, median over
 the runs) and the peak memory of a grading (``memory``, the largest over the runs).
 
+It also prints the CPU seconds of a grading (the grader's and every program it started,
+median) and what they make a floor for a class: a batch cannot grade 100 students of
+every exercise listed in less than their CPU seconds over the machine's cores, however
+many gradings run at once.
+
     python benchmarks/bench_grading.py [--runs 5] [--module-jobs auto] [EXERCISE ...]
 
 ``--module-jobs`` as for ``autograder grade``; with more than 1 the modules overlap, so
@@ -14,11 +19,13 @@ from __future__ import annotations
 
 import argparse
 import collections
+import functools
 import statistics
 import time
 from typing import Any
 
 from autograder.core.exercise import find_exercise, list_exercises
+from autograder.grading.capacity import machine_cores, measured
 from autograder.grading.run import grade
 from autograder.plugin.timing import PHASES
 
@@ -34,16 +41,19 @@ def main() -> None:
     args = parser.parse_args()
     exercises = [find_exercise(e) for e in args.exercises] or list_exercises()
     print(f"{'exercise':<22} {'score':>7} {'wall median':>12} {'min':>7} {'max':>7} "
-          f"{'node seen after (median)':>25}  ticks idle/cpu share/cap")
+          f"{'cpu median':>11} {'node seen after (median)':>25}  ticks idle/cpu share/cap")
     phases: dict[str, list[dict[str, float]]] = {}
     memory: dict[str, list[dict[str, float]]] = {}
+    cpu_medians: dict[str, float] = {}
     for exercise in exercises:
-        walls, startups, scores = [], [], set()
+        walls, cpus, startups, scores = [], [], [], set()
         ticks: collections.Counter[str] = collections.Counter()
         for _ in range(args.runs):
             began = time.monotonic()
-            result = grade(exercise, None, module_jobs=args.module_jobs)
+            result, share = measured(functools.partial(grade, exercise, None,
+                                                       module_jobs=args.module_jobs))
             walls.append(time.monotonic() - began)
+            cpus.append(share * walls[-1])
             startups += result.data.get("startup_seconds", [])
             scores.add(f"{result.score}/{result.max_score}")
             phases.setdefault(exercise.id, []).append(_phases(result.data.get("timing", {})))
@@ -52,8 +62,10 @@ def main() -> None:
             for module in result.data.get("pacing", {}).values():
                 ticks.update({k: v for k, v in module.items() if k in ("idle", "budget", "cap")})
         startup = f"{statistics.median(startups):.2f} s" if startups else "-"
+        cpu_medians[exercise.id] = statistics.median(cpus)
         print(f"{exercise.id:<22} {','.join(sorted(scores)):>7} "
               f"{statistics.median(walls):>10.2f} s {min(walls):>6.2f} {max(walls):>6.2f} "
+              f"{cpu_medians[exercise.id]:>9.1f} s "
               f"{startup:>25}  {ticks['idle']}/{ticks['budget']}/{ticks['cap']}", flush=True)
     print("\nwhere the seconds went (median over runs, summed over test modules; rest: "
           "the grader's own work outside the tests)")
@@ -61,6 +73,9 @@ def main() -> None:
     for name, runs in phases.items():
         print(f"{name:<22}" + "".join(
             f"{statistics.median(r[c] for r in runs):>12.2f}" for c in COLUMNS))
+    cores, cpu = machine_cores(), sum(cpu_medians.values())
+    print(f"\nCPU of one student's gradings: {cpu:.1f} s; 100 students need at least "
+          f"{100 * cpu / cores / 60:.0f} min on {cores:g} cores, however many at once")
     print("\npeak memory of a grading, MB (largest over runs; grader: pytest, world and "
           "probe in one process; student: its largest process)")
     print(f"{'exercise':<22} {'grader':>8} {'student':>8} {'total':>8}")
