@@ -218,3 +218,25 @@ def test_grade_batch_runs_modules_at_once_only_when_it_grades_one_at_a_time(
                                         str(tmp_path / "out"), *options])
     assert outcome.exit_code == 0, outcome.output
     assert asked == [expected, expected]
+
+
+def test_a_childs_report_is_parsed_again_only_when_it_changed(tmp_path: Path,
+                                                               monkeypatch) -> None:  # noqa: ANN001
+    from autograder.core import report
+    from autograder.grading.children import Child
+
+    path, key = tmp_path / "report.json", b"k" * 32
+    child = Child(None, path, key, tmp_path / "pytest.log", 0.0)  # type: ignore[arg-type]
+    assert child.reported_tests() == []  # no report yet
+    parsed = []
+    real_read = report.read
+    monkeypatch.setattr(report, "read", lambda *a, **kw: parsed.append(1) or real_read(*a, **kw))
+    report.write(path, [_test(PUBLIC, "test_one")], {}, key)
+    assert [t.name for t in child.reported_tests()] == ["test_one"]
+    assert [t.name for t in child.reported_tests()] == ["test_one"]
+    assert len(parsed) == 1  # unchanged: the tests as last read
+    report.write(path, [_test(PUBLIC, "test_one"), _test(PUBLIC, "test_two")], {}, key)
+    assert [t.name for t in child.reported_tests()] == ["test_one", "test_two"]
+    assert len(parsed) == 2
+    report.write(path, [_test(PUBLIC, "test_one")], {}, b"x" * 32)  # not ours: forged
+    assert child.reported_tests() == []
