@@ -68,7 +68,7 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from typing import Literal, Protocol
 
-from sim.procstate import ProcessReader, ProcessState, ProcessStateReader
+from sim.procstate import ProcessReader, ProcessState, read_process_state
 
 DEFAULT_CLOCK_HZ = 20.0
 """Most ``/clock`` messages per wall second; see the module's docstring for why 20."""
@@ -156,7 +156,7 @@ class Pacer:
 
     def __init__(self, dt: float, real_time_factor: float = 1.0,
                  policy: PacingPolicy | None = None, *, clock: Clock | None = None,
-                 read_process: ProcessReader | None = None,
+                 read_process: ProcessReader = read_process_state,
                  condition: threading.Condition | None = None) -> None:
         if real_time_factor < 0:
             raise ValueError("real_time_factor must be >= 0")
@@ -164,13 +164,7 @@ class Pacer:
         self.policy = policy or PacingPolicy()
         self.condition = condition or threading.Condition(threading.RLock())
         self._clock: Clock = clock or SystemClock()
-        # By default a reader of its own, which keeps the watched threads' /proc files
-        # open between looks (closed as processes are unwatched, and once stopped): a
-        # hold looks every poll_interval, and a look opening them afresh cost several
-        # times as much CPU (benchmarks/bench_procstate.py).
-        reader = ProcessStateReader()
-        self._reader = reader if read_process is None else None
-        self._read: ProcessReader = reader if read_process is None else read_process
+        self._read = read_process
         self._rtf = real_time_factor
         self._adaptive_tick = 1.0 / self.policy.clock_hz
         self._running = True
@@ -244,7 +238,6 @@ class Pacer:
         """Also hold ticks while process ``pid`` has work (None: watch nothing)."""
         with self.condition:
             if pid is None:
-                self._forget(*self._pids)
                 self._pids.clear()
                 self._listening.clear()
                 self._closing.clear()
@@ -258,16 +251,10 @@ class Pacer:
 
     def unwatch(self, pid: int) -> None:
         with self.condition:
-            self._forget(pid)
             self._pids.discard(pid)
             self._listening.discard(pid)
             self._closing.discard(pid)
             self._reserve.pop(pid, None)
-
-    def _forget(self, *pids: int) -> None:
-        if self._reader is not None:
-            for pid in pids:
-                self._reader.forget(pid)
 
     def closing(self, pid: int) -> None:
         """Process ``pid`` is being stopped: hold ticks while it has work, as before, but
@@ -328,8 +315,6 @@ class Pacer:
                 self._clock.wait(self.condition, lambda: not (self._running and self._paused))
                 self._start = self._clock.monotonic()  # the schedule starts afresh
             if not self._running:
-                if self._reader is not None:
-                    self._reader.close()
                 return None
             return self._plan(self._rtf)
 

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import collections
 import math
-import os
 import threading
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -450,26 +449,3 @@ def test_bad_settings_are_refused() -> None:
         make(1.0, clock_hz=0.0)
     with pytest.raises(ValueError):
         make(1.0).pacer.set_real_time_factor(-0.5)
-
-
-def test_the_pacers_own_reader_closes_its_files() -> None:
-    """By default the pacer reads /proc with files held open: it lets go of a process's
-    files once it is unwatched, and of all of them once stopped."""
-    def open_fds() -> int:
-        return len(os.listdir("/proc/self/fd"))
-
-    pacer = Pacer(DT, 1.0, clock=FakeClock())
-    before = open_fds()
-    with pacer.condition:
-        pacer.watch(os.getpid())
-        pacer.about_to_publish()
-    assert open_fds() > before
-    pacer.unwatch(os.getpid())
-    assert open_fds() == before
-    with pacer.condition:
-        pacer.watch(os.getpid())
-        pacer.about_to_publish()
-    assert open_fds() > before
-    pacer.stop()
-    assert pacer.next_tick() is None
-    assert open_fds() == before

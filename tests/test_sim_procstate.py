@@ -11,13 +11,7 @@ from collections.abc import Iterator
 import pytest
 
 from sim.pacing import DEFAULT_CPU_BUDGET
-from sim.procstate import (
-    IDLE,
-    ProcessReader,
-    ProcessStateReader,
-    process_busy,
-    read_process_state,
-)
+from sim.procstate import IDLE, process_busy, read_process_state
 
 WALL = 20.0
 
@@ -40,19 +34,6 @@ def _poll(condition, timeout: float = WALL) -> bool:  # noqa: ANN001
     return bool(condition())
 
 
-@pytest.fixture(params=["fresh", "held"])
-def read(request: pytest.FixtureRequest) -> Iterator[ProcessReader]:
-    """Both readers: files opened afresh each time, and files held between readings."""
-    if request.param == "fresh":
-        yield read_process_state
-        return
-    reader = ProcessStateReader()
-    try:
-        yield reader
-    finally:
-        reader.close()
-
-
 @pytest.fixture
 def spinner() -> Iterator[subprocess.Popen[str]]:
     proc = _spinning()
@@ -63,29 +44,27 @@ def spinner() -> Iterator[subprocess.Popen[str]]:
         proc.wait()
 
 
-def test_process_busy_reads_proc(read: ProcessReader) -> None:
+def test_process_busy_reads_proc() -> None:
     assert process_busy(os.getpid())  # this thread is running right now
     assert not process_busy(2**22 + 12345)  # no such process
-    assert read(os.getpid()).busy
-    assert read(2**22 + 12345) == IDLE
+    assert read_process_state(2**22 + 12345) == IDLE
 
 
-def test_a_computing_process_is_busy_and_uses_cpu(read: ProcessReader,
-                                                  spinner: subprocess.Popen[str]) -> None:
-    start = read(spinner.pid)
+def test_a_computing_process_is_busy_and_uses_cpu(spinner: subprocess.Popen[str]) -> None:
+    start = read_process_state(spinner.pid)
     assert start.busy and start.cpu_ns > 0
-    assert _poll(lambda: read(spinner.pid).cpu_ns > start.cpu_ns + 20_000_000)
+    assert _poll(lambda: read_process_state(spinner.pid).cpu_ns > start.cpu_ns + 20_000_000)
 
 
-def test_a_blocked_process_is_idle_and_uses_no_cpu(read: ProcessReader) -> None:
+def test_a_blocked_process_is_idle_and_uses_no_cpu() -> None:
     proc = subprocess.Popen([sys.executable, "-c", "import sys; sys.stdin.read()"],
                             stdin=subprocess.PIPE)
     try:
         assert _poll(lambda: not process_busy(proc.pid))  # once start-up is over
-        start = read(proc.pid)
+        start = read_process_state(proc.pid)
         samples = []
         for _ in range(10):  # a tenth of a second of samples
-            samples.append(read(proc.pid))
+            samples.append(read_process_state(proc.pid))
             time.sleep(0.01)
         assert samples == [start] * 10  # not busy, and no CPU time used
     finally:
@@ -94,7 +73,7 @@ def test_a_blocked_process_is_idle_and_uses_no_cpu(read: ProcessReader) -> None:
 
 
 @pytest.mark.skipif(not hasattr(os, "sched_setaffinity"), reason="needs sched_setaffinity")
-def test_a_starved_process_is_busy_but_gets_no_cpu(read: ProcessReader) -> None:
+def test_a_starved_process_is_busy_but_gets_no_cpu() -> None:
     """Runnable without a CPU (a busy machine) reads busy, with CPU time nearly still: the
     pacing then holds the world for it (test_sim_pacing's starved process)."""
     hog, starved = _spinning(), _spinning()
@@ -102,10 +81,10 @@ def test_a_starved_process_is_busy_but_gets_no_cpu(read: ProcessReader) -> None:
         for proc in (hog, starved):  # both on CPU 0; the "student" at the lowest priority
             os.sched_setaffinity(proc.pid, {0})
         os.setpriority(os.PRIO_PROCESS, starved.pid, 19)
-        start = read(starved.pid)
+        start = read_process_state(starved.pid)
         samples = []
         for _ in range(50):  # half a second of samples
-            samples.append(read(starved.pid))
+            samples.append(read_process_state(starved.pid))
             time.sleep(0.01)
         used = samples[-1].cpu_ns - start.cpu_ns
     finally:
@@ -115,56 +94,3 @@ def test_a_starved_process_is_busy_but_gets_no_cpu(read: ProcessReader) -> None:
     assert all(s.busy for s in samples)
     # At this rate it would not use its CPU budget within the 2 s cap of a hold.
     assert used < DEFAULT_CPU_BUDGET * 1e9 / 4, used
-
-
-# Starts 8 threads that wait on stdin: a line ends them, the next line ends the process.
-THREADS = [sys.executable, "-c", """
-import sys, threading
-gate = threading.Event()
-threads = [threading.Thread(target=gate.wait) for _ in range(8)]
-for t in threads: t.start()
-print('started', flush=True)
-sys.stdin.readline(); gate.set()
-for t in threads: t.join()
-print('joined', flush=True)
-sys.stdin.readline()
-"""]
-
-
-def _open_fds() -> int:
-    return len(os.listdir("/proc/self/fd"))
-
-
-def test_held_files_follow_the_threads_and_are_closed() -> None:
-    """The held reader reads what a fresh one does, lets go of the files of threads that
-    end and of processes that end, and closes what it holds when told to."""
-    proc = subprocess.Popen(THREADS, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
-    assert proc.stdin is not None and proc.stdout is not None
-    reader = ProcessStateReader()
-    before = _open_fds()
-    try:
-        assert proc.stdout.readline() == "started\n"
-        assert _poll(lambda: not process_busy(proc.pid))
-        assert reader(proc.pid) == read_process_state(proc.pid)
-        assert _open_fds() == before + 2 * 9  # stat and schedstat of 9 threads
-        proc.stdin.write("\n")
-        proc.stdin.flush()
-        assert proc.stdout.readline() == "joined\n"
-        assert _poll(lambda: not process_busy(proc.pid))
-        assert reader(proc.pid) == read_process_state(proc.pid)
-        assert _open_fds() == before + 2  # the main thread's only
-        reader.forget(proc.pid)
-        assert _open_fds() == before
-        reader(proc.pid)
-        proc.stdin.write("\n")
-        proc.stdin.flush()
-        proc.wait()
-        assert reader(proc.pid) == IDLE  # gone: its files are closed
-        assert _open_fds() == before
-        reader(os.getpid())
-        reader.close()
-        assert _open_fds() == before
-    finally:
-        proc.kill()
-        proc.wait()
-        reader.close()
