@@ -238,8 +238,7 @@ _JOBS = _CountOrAuto(lambda: _("--jobs must be a number from 1 to 64 or auto, go
 _module_jobs = click.option(
     "--module-jobs", type=_MODULE_JOBS, default="auto", show_default=True,
     help="Test modules run at the same time within the grading, each in a child of its "
-         "own on its own ROS domain; 'auto': one per module, at most two per core, as far "
-         "as free memory allows. "
+         "own on its own ROS domain; 'auto': one per module as far as the cores go. "
          "--domain means 1.")
 _record = click.option("--record", type=click.Path(path_type=Path, file_okay=False),
                        default=None, help="Record each test module's ROS graph as a rosbag2 "
