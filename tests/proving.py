@@ -33,7 +33,6 @@ import dataclasses
 import difflib
 import functools
 import json
-import math
 import os
 import re
 import sys
@@ -46,7 +45,6 @@ import yaml
 
 from autograder.core.exercise import Exercise, find_exercise
 from autograder.core.results import RunResult
-from autograder.grading.capacity import machine_cores
 from autograder.grading.run import grade
 
 SUBMISSIONS = Path(__file__).parent / "submissions"
@@ -282,11 +280,9 @@ class Proof:
         jobs["starter"] = exercise.starter
         for name, variant in self.variants.items():
             jobs[name] = variant.submission(exercise, workdir)
-        # One child per core each: the load each proof's ``jobs`` was chosen and proved at
-        # (auto's own two per core, run by several gradings at once, overloads the machine:
-        # parameter_validation's proof took 121 s against 86 s; at one child each, as a
-        # batch grades, error_handling's took 154 s against 123 s, its cores half idle).
-        module_jobs = max(1, math.floor(machine_cores()))
+        # Several gradings at once already share the cores: one child each, as a batch
+        # grades (grade-batch, autograder validate).
+        module_jobs = 1 if self.jobs > 1 else "auto"
         with ThreadPoolExecutor(max_workers=self.jobs) as pool:
             futures = {name: pool.submit(grade, exercise, path, module_jobs=module_jobs)
                        for name, path in jobs.items()}
