@@ -280,12 +280,8 @@ class Proof:
         jobs["starter"] = exercise.starter
         for name, variant in self.variants.items():
             jobs[name] = variant.submission(exercise, workdir)
-        # Several gradings at once already share the cores: one child each, as a batch
-        # grades (grade-batch, autograder validate).
-        module_jobs = 1 if self.jobs > 1 else "auto"
         with ThreadPoolExecutor(max_workers=self.jobs) as pool:
-            futures = {name: pool.submit(grade, exercise, path, module_jobs=module_jobs)
-                       for name, path in jobs.items()}
+            futures = {name: pool.submit(grade, exercise, path) for name, path in jobs.items()}
             return {name: future.result() for name, future in futures.items()}
 
 
