@@ -16,17 +16,8 @@ from pathlib import Path
 from typing import Any, Literal
 
 from autograder.core.report import RawReport, RawTest
-from autograder.grading.capacity import choose_jobs
 
 ModuleJobs = int | Literal["auto"]
-
-# Cores one child keeps busy: its world is paced by the simulated clock, so it mostly waits
-# (0.37 to 0.56 of a core measured, children of one grading at once on 2 cores; README
-# "What grading does"). So ``auto`` runs two children per core.
-CHILD_SHARE = 0.5
-# Resident memory of one child with its student's program (about 185 MB measured), rounded
-# up so that a student's program that allocates more still fits.
-CHILD_MB = 250.0
 
 
 def find_modules(folders: Iterable[Path]) -> list[Path]:
@@ -40,17 +31,10 @@ def find_modules(folders: Iterable[Path]) -> list[Path]:
     return found
 
 
-def children_for(requested: ModuleJobs, modules: int, cores: float,
-                 memory_mb: float = math.inf) -> int:
+def children_for(requested: ModuleJobs, modules: int, cores: float) -> int:
     """How many children a grading of ``modules`` test modules runs: ``auto`` is one per
-    module as far as ``cores`` (at :data:`CHILD_SHARE` each) and ``memory_mb`` (at
-    :data:`CHILD_MB` each) go; never more children than modules, never fewer than one."""
-    if requested == "auto":
-        wanted = choose_jobs(cores=cores, memory_mb=memory_mb, cpu_share=CHILD_SHARE,
-                             grading_mb=CHILD_MB, students=modules, ceiling=modules,
-                             load=1.0).jobs
-    else:
-        wanted = int(requested)
+    module as far as the cores go; never more children than modules, never fewer than one."""
+    wanted = max(1, math.floor(cores)) if requested == "auto" else int(requested)
     return max(1, min(wanted, modules))
 
 

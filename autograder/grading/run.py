@@ -25,7 +25,7 @@ from autograder.core.report import RawReport, RawTest
 from autograder.core.results import NotRun, RunResult, TestResult, exact
 from autograder.core.settings import RunSettings
 from autograder.grading import children
-from autograder.grading.capacity import machine_cores, machine_memory_mb
+from autograder.grading.capacity import machine_cores
 from autograder.grading.children import Progress, Watchers
 from autograder.grading.modules import ModuleJobs, children_for, find_modules, merge, share_out
 from autograder.i18n import _, get_language
@@ -50,15 +50,14 @@ def grade(exercise: Exercise, submission: Path | None, *, hidden: bool = True,
     With ``record``, each test module's graph is recorded as a rosbag2 bag in that folder
     (``data["bags"]``); a recording that fails is only a warning (``data["warnings"]``).
     ``module_jobs`` children run the test modules at once, each on a domain of its own
-    (``auto``: one per module, at most two per core, as far as memory allows); a given
-    ``domain`` means one child.
+    (``auto``: one per module as far as the cores go); a given ``domain`` means one child.
     """
     started = time.monotonic()
     isolation = detect()
     record, warnings = _record_folder(record)
     plan = _Plan.of(exercise, hidden)
     wanted = 1 if domain is not None else children_for(module_jobs, len(plan.modules),
-                                                          machine_cores(), machine_memory_mb())
+                                                          machine_cores())
     try:
         with contextlib.ExitStack() as stack:
             locks = [stack.enter_context(hold_domain(domain))]
