@@ -8,10 +8,11 @@ from pathlib import Path
 
 import pytest
 
+from autograder.core import report
 from autograder.core.exercise import load_exercise
 from autograder.core.report import RawReport, RawTest
 from autograder.core.results import RunResult
-from autograder.grading.children import Ended
+from autograder.grading.children import Child, Ended
 from autograder.grading.modules import children_for, find_modules, merge, share_out
 from autograder.grading.run import GRADER_FAULT, _result
 
@@ -217,11 +218,8 @@ def test_grade_batch_runs_modules_at_once_only_when_it_grades_one_at_a_time(
     assert asked == [expected, expected]
 
 
-def test_a_childs_report_is_parsed_again_only_when_it_changed(tmp_path: Path,
-                                                               monkeypatch) -> None:  # noqa: ANN001
-    from autograder.core import report
-    from autograder.grading.children import Child
-
+def test_a_childs_report_is_parsed_again_only_when_it_changed(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     path, key = tmp_path / "report.json", b"k" * 32
     child = Child(None, path, key, tmp_path / "pytest.log", 0.0)  # type: ignore[arg-type]
     assert child.reported_tests() == []  # no report yet
