@@ -27,8 +27,9 @@ MACHINE = {"cores": 2.0, "memory_mb": 8000.0, "grading_mb": 400.0}
     (0.2, 20, 1000.0, 2, "memory"),     # 1000 MB at 400 MB each
     (0.01, 20, 8000.0, 8, "ceiling"),   # a grading that hardly computes: the checked most
     (3.0, 20, 100.0, 1, "cpu"),         # nothing fits: still one
+    (0.01, 20, float("inf"), 8, "ceiling"),  # free memory unknown: not a bound
 ], ids=["clock-bound", "cpu-bound", "half-core", "few-students", "low-memory", "ceiling",
-        "never-zero"])
+        "never-zero", "memory-unknown"])
 def test_choose_jobs(share, students, memory, jobs, bound) -> None:
     choice = choose_jobs(**{**MACHINE, "memory_mb": memory}, cpu_share=share,
                          students=students)

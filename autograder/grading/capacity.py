@@ -54,12 +54,10 @@ def choose_jobs(*, cores: float, memory_mb: float, cpu_share: float, grading_mb:
     each, fit in ``memory_mb`` at ``grading_mb`` each, and no more than ``students`` or
     ``ceiling``; always at least one."""
     share = max(cpu_share, MIN_SHARE)
-    limits: dict[Bound, int] = {
-        "cpu": math.floor(cores * load / share + 1e-9),
-        "memory": math.floor(memory_mb / grading_mb) if grading_mb > 0 else ceiling,
-        "students": students,
-        "ceiling": ceiling,
-    }
+    limits: dict[Bound, int] = {"cpu": math.floor(cores * load / share + 1e-9)}
+    if grading_mb > 0 and math.isfinite(memory_mb):  # unknown free memory bounds nothing
+        limits["memory"] = math.floor(memory_mb / grading_mb)
+    limits.update(students=students, ceiling=ceiling)
     bound = min(limits, key=lambda name: limits[name])  # first listed wins a tie
     return Choice(max(1, limits[bound]), bound, cores, share, memory_mb, grading_mb)
 
