@@ -91,6 +91,53 @@ def test_the_fast_dds_profile_announces_participants_often():
         assert dds_env(Isolation(strict))[PROFILE_ENV] == str(FASTDDS_PROFILE)
 
 
+_SUBSCRIBER = """
+import rclpy
+from geometry_msgs.msg import Twist
+rclpy.init()
+node = rclpy.create_node("acks_subscriber")
+node.create_subscription(Twist, "/cmd_vel", lambda message: None, 10)
+rclpy.spin(node)
+"""
+_PUBLISHER = """
+import json, time
+import rclpy
+from geometry_msgs.msg import Twist
+from rclpy.duration import Duration
+rclpy.init()
+node = rclpy.create_node("acks_publisher")
+publisher = node.create_publisher(Twist, "/cmd_vel", 10)
+deadline = time.monotonic() + 20
+while publisher.get_subscription_count() < 1 and time.monotonic() < deadline:
+    time.sleep(0.01)
+acked = []
+for _ in range(3):
+    publisher.publish(Twist())
+    acked.append(publisher.wait_for_all_acked(Duration(seconds=1.5)))
+print(json.dumps(acked))
+"""
+
+
+def test_a_reliable_stop_is_acknowledged_within_the_wait(tmp_path):
+    """A reliable writer is acknowledged within a ``wait_for_all_acked`` that a clean exit
+    does (error_handling's README: 1 s). Acks come only after the writer's heartbeat: with
+    Fast DDS's default of one every 3 s, three waits in a row cannot all succeed."""
+    from autograder.sandbox.domains import hold_domain
+
+    with hold_domain() as lock:
+        env = {**os.environ, "ROS_DOMAIN_ID": str(lock.domain),
+               **{k: v for k, v in dds_env(Isolation(False)).items() if v is not None}}
+        subscriber = subprocess.Popen([sys.executable, "-c", _SUBSCRIBER], env=env,
+                                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        try:
+            published = subprocess.run([sys.executable, "-c", _PUBLISHER], env=env,
+                                       capture_output=True, text=True, timeout=60)
+        finally:
+            subscriber.kill()
+            subscriber.wait()
+    assert json.loads(published.stdout) == [True, True, True], published.stderr
+
+
 def test_user_tasks_counts_threads_as_rlimit_nproc_does(tmp_path):
     """Without a uid of its own, a student's RLIMIT_NPROC is what its user already runs plus
     its own allowance, so the count is of threads (as RLIMIT_NPROC counts), by real uid."""
