@@ -124,18 +124,20 @@ def test_a_reliable_stop_is_acknowledged_within_the_wait(tmp_path):
     Fast DDS's default of one every 3 s, three waits in a row cannot all succeed."""
     from autograder.sandbox.domains import hold_domain
 
-    with hold_domain() as lock:
-        env = {**os.environ, "ROS_DOMAIN_ID": str(lock.domain),
-               **{k: v for k, v in dds_env(Isolation(False)).items() if v is not None}}
-        subscriber = subprocess.Popen([sys.executable, "-c", _SUBSCRIBER], env=env,
-                                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    with hold_domain() as lock:  # both launched as a student's program is, profile and all
+        subscriber, publisher = (
+            student_process(_program(tmp_path / name, text), [], Limits(), domain=lock.domain,
+                            strict=False, course=COURSE)
+            for name, text in (("subscriber", _SUBSCRIBER), ("publisher", _PUBLISHER)))
+        subscriber.start()
         try:
-            published = subprocess.run([sys.executable, "-c", _PUBLISHER], env=env,
-                                       capture_output=True, text=True, timeout=60)
+            publisher.start()
+            assert publisher.wait(60) == 0, publisher.output_text()
+            publisher.stop()
         finally:
-            subscriber.kill()
-            subscriber.wait()
-    assert json.loads(published.stdout) == [True, True, True], published.stderr
+            subscriber.stop()
+    assert json.loads(publisher.output_text().splitlines()[-1]) == [True, True, True], \
+        publisher.output_text()
 
 
 def test_user_tasks_counts_threads_as_rlimit_nproc_does(tmp_path):
