@@ -1,7 +1,7 @@
 """The error_handling exercise proves its tests: every submission graded end to end.
 
 The reference solution scores 100% (five times, with other gradings running beside it:
-the shutdown trials and the 60 s faulty run must not depend on load), the starter scores
+the shutdown trials and the 43 s faulty run must not depend on load), the starter scores
 below the pass mark, every other correct design (other executors, other ways to take a
 signal) scores 100%, and each known-bad variant loses exactly the tests its expect.yaml
 names.  Every grading is a whole one; they run four at a time, on their own ROS domains.

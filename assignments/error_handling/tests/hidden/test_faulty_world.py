@@ -1,4 +1,4 @@
-"""Hidden tests: 60 s of simulation time among obstacles, with the lidar misbehaving.
+"""Hidden tests: 43 s of simulation time among obstacles, with the lidar misbehaving.
 
 The faults are injected relative to the moment the node first drives, between scans (a
 fault span starts and ends 0.05 s after a scan), so the same scans are affected in
@@ -23,23 +23,26 @@ from sim.worldfile import Fault
 
 pytestmark = pytest.mark.world("obstacles")
 
-RUN = 60.0
-# Faults, with start and end counted from the start of the run.
+RUN = 43.0
+# Faults, with start and end counted from the start of the run: every kind the public tests
+# feed one by one, and three dropouts, each fault 1.5 s after the one before ended (a
+# dropout's end leaves the 1 s the robot has to move again).  It was 60 s with gaps of 2 to
+# 3.5 s; the shorter gaps changed no proof's verdict (tests/test_grading_error_handling.py).
 SCHEDULE = (
-    Fault(kind="nan", start=4.0, end=7.0, fraction=0.3),
-    Fault(kind="empty", start=9.0, end=9.5),
-    Fault(kind="dropout", start=12.0, end=16.0),
-    Fault(kind="wrong_length", start=19.0, end=19.5, length=180),
-    Fault(kind="inf", start=22.0, end=25.0, fraction=0.2),
-    Fault(kind="neg_inf", start=22.0, end=25.0, fraction=0.1),
-    Fault(kind="below_min", start=27.0, end=30.0, fraction=0.1),
-    Fault(kind="above_max", start=27.0, end=30.0, fraction=0.1),
-    Fault(kind="nan", start=32.0, end=33.0, fraction=0.5),
-    Fault(kind="dropout", start=36.0, end=39.0),
-    Fault(kind="empty", start=42.0, end=42.3),
-    Fault(kind="wrong_length", start=45.0, end=45.5, length=400),
-    Fault(kind="nan", start=48.0, end=52.0, fraction=0.2),
-    Fault(kind="dropout", start=54.0, end=56.0),
+    Fault(kind="nan", start=3.0, end=5.0, fraction=0.3),
+    Fault(kind="empty", start=6.5, end=7.0),
+    Fault(kind="dropout", start=8.5, end=12.5),
+    Fault(kind="wrong_length", start=14.0, end=14.5, length=180),
+    Fault(kind="inf", start=16.0, end=18.0, fraction=0.2),
+    Fault(kind="neg_inf", start=16.0, end=18.0, fraction=0.1),
+    Fault(kind="below_min", start=19.5, end=21.5, fraction=0.1),
+    Fault(kind="above_max", start=19.5, end=21.5, fraction=0.1),
+    Fault(kind="nan", start=23.0, end=24.0, fraction=0.5),
+    Fault(kind="dropout", start=25.5, end=28.5),
+    Fault(kind="empty", start=30.0, end=30.3),
+    Fault(kind="wrong_length", start=31.8, end=32.3, length=400),
+    Fault(kind="nan", start=33.8, end=36.8, fraction=0.2),
+    Fault(kind="dropout", start=38.3, end=40.3),
 )
 # Stopped within the 0.5 s watchdog, one control cycle, braking (< 0.1 s at the world's
 # 2.5 m/s^2 and 6 rad/s^2) and a tick of message delay.
@@ -130,7 +133,7 @@ def _died(run: Run, student) -> None:
 
 @pytest.mark.points(2)
 def test_stays_alive(run, student):
-    """Through 60 s of faulty scans the node stays alive and keeps publishing"""
+    """Through 43 s of faulty scans the node stays alive and keeps publishing"""
     _died(run, student)
     stamps = [t for t in run.commands.times if run.start <= t <= run.end] + [run.end]
     gaps = [(b - a, a) for a, b in zip([run.start, *stamps], stamps, strict=False)]
