@@ -24,6 +24,6 @@ def streams(probe, student):
 
 @pytest.fixture(scope="module")
 def run(probe, world, streams):
-    """Watched once per module, 23.5 s of simulation time from the node's start: to 20.5 s at
-    the world's pace, then at half that (helpers.SWITCH_AT, END_AT)."""
+    """Watched once per module, 22.5 s of simulation time from the node's start: to 21.5 s at
+    the world's pace, then at half real time (helpers.SWITCH_AT, END_AT)."""
     return observe(probe, world, streams)

@@ -1,6 +1,6 @@
 """Public tests: a 10 Hz control loop, 1 Hz status and 0.1 Hz plans, all in simulation time.
 
-One run per module: 20.5 s of simulation time at twice real time, then 2 s at half real time.
+One run per module: 21.5 s of simulation time at twice real time, then 1 s at half real time.
 """
 
 import pytest
