@@ -20,13 +20,13 @@ MACHINE = {"cores": 2.0, "memory_mb": 8000.0, "grading_mb": 400.0}
 
 
 @pytest.mark.parametrize(("share", "students", "memory", "jobs", "bound"), [
-    (0.4, 20, 8000.0, 6, "cpu"),        # clock-bound: several per core
-    (1.0, 20, 8000.0, 2, "cpu"),        # CPU-bound: a core each, a quarter over at most
-    (0.5, 20, 8000.0, 5, "cpu"),
+    (0.6, 20, 8000.0, 6, "cpu"),        # clock-bound: several per core
+    (1.0, 20, 8000.0, 4, "cpu"),        # CPU-bound: two a core at most
+    (0.7, 20, 8000.0, 5, "cpu"),
     (0.2, 3, 8000.0, 3, "students"),    # no more than there are students
     (0.2, 20, 1000.0, 2, "memory"),     # 1000 MB at 400 MB each
     (0.01, 20, 8000.0, 8, "ceiling"),   # a grading that hardly computes: the checked most
-    (3.0, 20, 100.0, 1, "cpu"),         # nothing fits: still one
+    (5.0, 20, 100.0, 1, "cpu"),         # nothing fits: still one
     (0.01, 20, float("inf"), 8, "ceiling"),  # free memory unknown: not a bound
 ], ids=["clock-bound", "cpu-bound", "half-core", "few-students", "low-memory", "ceiling",
         "never-zero", "memory-unknown"])
@@ -39,7 +39,7 @@ def test_choose_jobs(share, students, memory, jobs, bound) -> None:
 def test_a_first_grading_that_only_hangs_is_not_believed_to_cost_nothing() -> None:
     choice = choose_jobs(cores=2, memory_mb=1e6, grading_mb=400, cpu_share=0.0,
                          students=100, ceiling=100)
-    assert choice.cpu_share == capacity.MIN_SHARE and choice.jobs == 16
+    assert choice.cpu_share == capacity.MIN_SHARE and choice.jobs == 26
 
 
 @pytest.mark.parametrize("bound", ["cpu", "memory", "students", "ceiling"])
