@@ -25,9 +25,10 @@ from autograder.i18n import _, ngettext
 # gaps are filled only well past the cores; past that each grading only stretches, the
 # pacing holding simulation time for a process that waits for a CPU. On 2 cores
 # error_handling's 16 students went at 294 an hour at 0.75 (3 at once), 448 at 1.25 (5)
-# and 596 with 8 at once (2.0 at its 0.46 of a core), and with 8 at once every exercise
-# graded faster than at 4 or at 1.25's choice, every score full (README "How many at
-# once"). A grading that fills a core by itself gets two per core: no faster, no slower.
+# and 596 with 8 at once (2.0 at its 0.46 of a core), and 8 at once graded faster than 4
+# for every exercise but parameter_validation, and than 1.25's choice for all five, every
+# score full (README "How many at once"). A grading that fills a core by itself gets two
+# per core: no faster, no slower.
 TARGET_LOAD = 2.0
 # Most gradings at once: the highest concurrency measured to keep every score full
 # (README "A whole class", benchmarks/bench_batch.py).

@@ -27,7 +27,8 @@ RUN = 43.0
 # Faults, with start and end counted from the start of the run: every kind the public tests
 # feed one by one, and three dropouts, each fault 1.5 s after the one before ended (a
 # dropout's end leaves the 1 s the robot has to move again).  It was 60 s with gaps of 2 to
-# 3.5 s; the shorter gaps changed no proof's verdict (tests/test_grading_error_handling.py).
+# 3.5 s; the shorter gaps changed no proof's verdict but that no_watchdog, driving blind,
+# may now also hit a wall (tests/submissions/error_handling/no_watchdog/expect.yaml).
 SCHEDULE = (
     Fault(kind="nan", start=3.0, end=5.0, fraction=0.3),
     Fault(kind="empty", start=6.5, end=7.0),
