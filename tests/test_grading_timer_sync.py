@@ -82,9 +82,9 @@ def test_report_plots_the_intervals_each_rate_test_measured(graded):
     (control,) = charts["test_control_rate"]
     assert control["title"] == "cmd_vel"
     assert control["limit"] == pytest.approx(0.15)  # the largest gap allowed
-    assert len(control["points"]) > 180  # 22 s at 10 Hz, less what discovery took
+    assert len(control["points"]) > 100  # 12 s at 10 Hz, less what discovery took
     assert all(gap <= control["limit"] for _t, gap in control["points"])  # the reference keeps it
-    assert len(charts["test_control_while_planning"]) >= 2  # one per planner run
+    assert len(charts["test_control_while_planning"]) == 1  # one per planner run
     for name in ("test_status_rate", "test_plan_rate", "test_rates_at_half_speed"):
         assert [len(c["points"]) > 0 for c in charts[name]] == [True], name
     page = to_html(result, find_exercise("timer_sync").folder)

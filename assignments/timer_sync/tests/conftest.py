@@ -1,4 +1,4 @@
-"""Fixtures shared by the timer_sync tests: the node's three streams and one long run."""
+"""Fixtures shared by the timer_sync tests: the node's three streams and one run."""
 
 import sys
 from pathlib import Path
@@ -24,6 +24,6 @@ def streams(probe, student):
 
 @pytest.fixture(scope="module")
 def run(probe, world, streams):
-    """Watched once per module, 22.5 s of simulation time from the node's start: to 21.5 s at
+    """Watched once per module, 12.25 s of simulation time from the node's start: to 11.75 s at
     the world's pace, then at half real time (helpers.SWITCH_AT, END_AT)."""
     return observe(probe, world, streams)

@@ -20,6 +20,8 @@ CONTROL_HZ = 10.0
 STATUS_PERIOD = 1.0
 PLAN_PERIOD = 10.0
 PLAN_SECONDS = 2.0
+# How far a plan may be from its expected time: a tick or two either side (sim seconds).
+PLAN_TOLERANCE = 0.25
 # The run: sim seconds at the exercise's pace (RTF 2, /clock at 40 Hz: ticks of 0.05 s of
 # sim time, as at RTF 1 and 20 Hz), then at OTHER_RTF.  A node timed by the wall clock
 # shows half its rates in sim time at RTF 2 and twice them at half pace.  Not faster: at
@@ -32,21 +34,28 @@ PLAN_SECONDS = 2.0
 # The node's timers begin when its clock does: at sim time 0 if it made them before its
 # first /clock (ROS time reads 0 until then), at the latest when it appeared on the graph
 # (``Streams.started``; sim time stands still while it starts).  On a loaded machine the
-# world may be 1-2 s old by then, so its planner runs from 10 to 12 s and from 20 to 22 s
-# of a clock that began anywhere in between.  The half-pace phase therefore starts at
-# SWITCH_AT of sim time (the earliest such clock's second run ends in it) and
-# the window closes END_AT after the node appeared (the latest clock's second plan is in),
-# 22.5 s in all.  One second or more at half pace shows a wall-clock node's doubled rate
-# (20 commands against 10; the tolerance is one), and a control timer that shares the
-# planner's thread loses half a second or more of it to the second run.  Each second at
-# half pace costs two of wall time: it was 2 s (from 20.5), 4 s of a 14 s watch.
-SWITCH_AT = 21.5
-END_AT = 22.5
+# world may be 1-2 s old by then, so its planner runs from 10 to 12 s of a clock that
+# began anywhere in between.  The public run therefore goes at half pace from SWITCH_AT of
+# sim time (the earliest such clock's first run still has 0.25 s to go) and closes END_AT
+# after the node appeared (the latest clock's first plan is in): 12.25 s in all, at least
+# 0.5 s of it at half pace.  That shows a wall-clock node's doubled rate (10 commands
+# against 5; the tolerance is one), and a control timer that shares the planner's thread
+# loses 0.25 s or more of it to the planner.  The plan period needs a second plan, 10 s
+# later: the hidden run watches to LONG_END_AT, at the world's pace throughout.  (One
+# public run of 22.5 s for both plans, its last second at half pace, made `check` take
+# 15.6 s; each second at half pace costs two of wall time.)
+SWITCH_AT = 11.75
+END_AT = 12.25
+LONG_END_AT = 22.5
+LONG_RTF = 4.0
 OTHER_RTF = 0.5
 # Discovery may cost the first messages: the window opens this long after the first one.
 SETTLE = 0.5
 # cmd_vel silent this long (sim s): the node froze, stop watching.
 FROZEN = 3.0
+# cmd_vel silent this long when the run ends: it froze too.  A planner run that blocks
+# control (2 s) ends 0.25 s or more before the public run does (see END_AT).
+FROZEN_AT_END = 1.0
 MAX_GAP = 0.15 + 1e-6
 RATE_TOLERANCE = 0.03
 
@@ -98,28 +107,39 @@ def _watch(probe, streams: Streams, seconds: float, wall_factor: float) -> float
     return None
 
 
-def observe(probe, world, streams: Streams) -> Run:
-    """Watch the node to END_AT after its start: at the world's pace until SWITCH_AT of sim
-    time, then at OTHER_RTF.  The world changes pace itself at those sim times (the grader's
-    thread may wake late on a loaded machine), so the phases are the same in every run."""
+def observe(probe, world, streams: Streams, end_at: float = END_AT,
+            switch_at: float | None = SWITCH_AT, rtf: float | None = None) -> Run:
+    """Watch the node to ``end_at`` after its start: at ``rtf`` (None: the world's pace)
+    until ``switch_at`` of sim time, then at OTHER_RTF (``switch_at`` None: not at all).
+    The world changes pace itself at those sim times (the grader's thread may wake late on
+    a loaded machine), so the phases are the same in every run."""
     commands = streams.commands
     if not probe.wait_for(lambda: len(commands) > 0, 5.0):
         return Run(None, None, probe.now, [], streams.statuses.items, streams.plans.items)
     pace = world.real_time_factor
-    switch_at, end = max(SWITCH_AT, probe.now), streams.started + END_AT
-    world.schedule_real_time_factor(switch_at, OTHER_RTF)
-    world.schedule_real_time_factor(end, pace)
+    if rtf is not None:
+        world.set_real_time_factor(rtf)
+    end = streams.started + end_at
+    if switch_at is not None:
+        switch_at = max(switch_at, probe.now)
+        world.schedule_real_time_factor(switch_at, OTHER_RTF)
+        world.schedule_real_time_factor(end, pace)
+    slowest = min(pace, rtf or pace, OTHER_RTF if switch_at is not None else pace)
     try:
         start = max(streams.started, commands.times[0]) + SETTLE
         probe.wait_for(lambda: probe.now >= start, SETTLE + 1.0)
-        frozen = _watch(probe, streams, end - probe.now, max(1.0, 1.0 / OTHER_RTF))
+        frozen = _watch(probe, streams, end - probe.now, max(1.0, 1.0 / slowest))
     finally:
         world.cancel_scheduled_pace()
         world.set_real_time_factor(pace)
-    switched = [t for t, rtf in world.pace_changes if t >= switch_at - 1e-9 and rtf == OTHER_RTF]
+    switched = [] if switch_at is None else [
+        t for t, rtf in world.pace_changes if t >= switch_at - 1e-9 and rtf == OTHER_RTF]
     switch = switched[0] if switched else None
     if frozen is None:
         _let_in_flight_arrive(probe, commands, end)
+        last = max((t for t in commands.times if t < end), default=start)
+        if end - last > FROZEN_AT_END:
+            frozen = last
     else:
         end = frozen + FROZEN
     return Run(start, switch, end, commands.items, streams.statuses.items,
@@ -163,6 +183,20 @@ def freeze_hint() -> str:
              "also blocks the /clock subscription which advances ROS time, so time itself "
              "stops. Spin a MultiThreadedExecutor and give the planner timer a callback "
              "group of its own.")
+
+
+def no_plan_hint(run: Run) -> str:
+    """Why too few plans came: the clock froze, the routes are counted but not published,
+    or no planner timer."""
+    if run.frozen_at is not None:
+        return freeze_hint()
+    counted = max((s["plans"] for s in map(parse_status, (m for _t, m in run.statuses))
+                   if s is not None), default=0)
+    if counted > len(run.plan_times()):
+        return _("status reported plans={counted}, so the planner runs, but its routes do "
+                 "not come on plan: publish each one there as a std_msgs/String.").format(
+            counted=counted)
+    return _("Create a 10 s timer that calls plan_route() and publishes the result on plan.")
 
 
 def planner_run_during(run: Run, a: float, b: float) -> tuple[float, float] | None:
