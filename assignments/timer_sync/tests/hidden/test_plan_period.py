@@ -1,6 +1,7 @@
 """Hidden tests: started with -p cruise_speed:=0.35, the node is watched for two plans.
 
-One run: 22.5 s of simulation time from the node's start, at twice real time throughout.
+One run: 22.5 s of simulation time from the node's start, at eight times real time
+(helpers.LONG_RTF): ticks of 0.2 s, on which the plans fall.
 """
 
 import pytest
@@ -25,7 +26,7 @@ pytestmark = pytest.mark.parameters({"cruise_speed": SPEED})
 
 @pytest.fixture(scope="module")
 def run(probe, world, streams):
-    """Watched to LONG_END_AT after the node's start, at the world's pace."""
+    """Watched to LONG_END_AT after the node's start, at LONG_RTF."""
     return observe(probe, world, streams, end_at=LONG_END_AT, switch_at=None, rtf=LONG_RTF)
 
 
