@@ -2,7 +2,9 @@
 the student's process start to its node being seen on the graph, and how the world's
 ticks went on (student idle, CPU share used, wall cap hit: see sim/bridge.py); then where
 the seconds went (the results file's ``timing``, summed over test modules, median over
-the runs) and the peak memory of a grading (``memory``, the largest over the runs).
+the runs) and the peak memory of a grading (``memory``, the largest over the runs): the
+children's resident sizes summed, an upper bound, and the footprint, the whole grading's
+PSS summed (see autograder/grading/footprint.py).
 
 It also prints the CPU seconds of a grading (the grader's and every program it started,
 median) and what they make a floor for a class: a batch cannot grade 100 students of
@@ -22,14 +24,13 @@ import collections
 import functools
 import statistics
 import time
+from collections.abc import Sequence
 from typing import Any
 
 from autograder.core.exercise import find_exercise, list_exercises
 from autograder.grading.capacity import machine_cores, measured
+from autograder.grading.footprint import INTERVAL
 from autograder.grading.run import grade
-from autograder.plugin.timing import PHASES
-
-COLUMNS = ("child_start", *PHASES, "checks", "rest", "total")
 
 
 def main() -> None:
@@ -42,7 +43,7 @@ def main() -> None:
     exercises = [find_exercise(e) for e in args.exercises] or list_exercises()
     print(f"{'exercise':<22} {'score':>7} {'wall median':>12} {'min':>7} {'max':>7} "
           f"{'cpu median':>11} {'node seen after (median)':>25}  ticks idle/cpu share/cap")
-    phases: dict[str, list[dict[str, float]]] = {}
+    timings: dict[str, list[dict[str, Any]]] = {}
     memory: dict[str, list[dict[str, float]]] = {}
     cpu_medians: dict[str, float] = {}
     for exercise in exercises:
@@ -56,7 +57,7 @@ def main() -> None:
             cpus.append(share * walls[-1])
             startups += result.data.get("startup_seconds", [])
             scores.add(f"{result.score}/{result.max_score}")
-            phases.setdefault(exercise.id, []).append(_phases(result.data.get("timing", {})))
+            timings.setdefault(exercise.id, []).append(result.data.get("timing", {}))
             if result.data.get("memory"):
                 memory.setdefault(exercise.id, []).append(result.data["memory"])
             for module in result.data.get("pacing", {}).values():
@@ -67,28 +68,40 @@ def main() -> None:
               f"{statistics.median(walls):>10.2f} s {min(walls):>6.2f} {max(walls):>6.2f} "
               f"{cpu_medians[exercise.id]:>9.1f} s "
               f"{startup:>25}  {ticks['idle']}/{ticks['budget']}/{ticks['cap']}", flush=True)
+    # Imported only after the gradings: the plugin's package brings rclpy and pytest into
+    # this process, about 20 MB more of this process's PSS in each grading's footprint.
+    from autograder.plugin.timing import PHASES
+
+    columns = ("child_start", *PHASES, "checks", "rest", "total")
     print("\nwhere the seconds went (median over runs, summed over test modules; rest: "
           "the grader's own work outside the tests)")
-    print(f"{'exercise':<22}" + "".join(f"{c:>12}" for c in COLUMNS))
-    for name, runs in phases.items():
+    print(f"{'exercise':<22}" + "".join(f"{c:>12}" for c in columns))
+    for name, runs in timings.items():
+        rows = [_phases(timing, PHASES) for timing in runs]
         print(f"{name:<22}" + "".join(
-            f"{statistics.median(r[c] for r in runs):>12.2f}" for c in COLUMNS))
+            f"{statistics.median(r[c] for r in rows):>12.2f}" for c in columns))
     cores, cpu = machine_cores(), sum(cpu_medians.values())
     print(f"\nCPU of one student's gradings: {cpu:.1f} s; 100 students need at least "
           f"{100 * cpu / cores / 60:.0f} min on {cores:g} cores, however many at once")
-    print("\npeak memory of a grading, MB (largest over runs; grader: pytest, world and "
-          "probe in one process; student: its largest process)")
-    print(f"{'exercise':<22} {'grader':>8} {'student':>8} {'total':>8}")
+    print("\npeak memory of a grading, MB (largest over runs). Resident sizes summed over "
+          "the children at once, an upper bound (grader: pytest, world and probe in one "
+          "process; student: its largest process);\nfootprint: the PSS of the grading's "
+          f"whole process tree (this process included) summed, sampled every {INTERVAL:g} s")
+    print(f"{'exercise':<22} {'grader':>8} {'student':>8} {'total':>8} {'footprint':>10}")
     for name, runs in memory.items():
-        peak = max(runs, key=lambda m: m["total_mb"])
-        print(f"{name:<22} {peak['grader_mb']:>8.1f} {peak['student_mb']:>8.1f} "
-              f"{peak['total_mb']:>8.1f}")
+        peak = max(runs, key=lambda m: m.get("total_mb", 0.0))
+        footprints = [m["footprint_mb"] for m in runs if m.get("footprint_mb") is not None]
+        footprint = f"{max(footprints):>10.1f}" if footprints else f"{'-':>10}"
+        print(f"{name:<22} {peak.get('grader_mb', 0.0):>8.1f} "
+              f"{peak.get('student_mb', 0.0):>8.1f} {peak.get('total_mb', 0.0):>8.1f} "
+              f"{footprint}")
 
 
-def _phases(timing: dict[str, Any]) -> dict[str, float]:
-    """One grading's seconds per column of :data:`COLUMNS`."""
+def _phases(timing: dict[str, Any], phases: Sequence[str]) -> dict[str, float]:
+    """One grading's seconds per column: ``child_start``, each of ``phases``, ``checks``,
+    ``rest`` and ``total``."""
     modules = timing.get("modules", {}).values()
-    row = {p: sum(m[p] for m in modules) for p in (*PHASES, "checks")}
+    row = {p: sum(m[p] for m in modules) for p in (*phases, "checks")}
     row["child_start"] = timing.get("child_start") or 0.0
     row["total"] = timing.get("total", 0.0)
     row["rest"] = max(0.0, row["total"] - row["child_start"] - timing.get("tests", 0.0))

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import dataclasses
+import resource
 from pathlib import Path
 
 import pytest
@@ -151,6 +152,11 @@ def test_a_grading_runs_its_modules_in_two_children_on_two_domains() -> None:
     assert set(result.data["timing"]["modules"]) == modules
     assert set(result.data["pacing"]) == {m.rpartition("/")[2] for m in modules}
     assert set(result.data["recordings"]) == set(result.data["pacing"])
+    # The tree's PSS: this process, two children and a student each at a time, each
+    # counting at most its resident size (PSS divides the pages it shares).
+    memory = result.data["memory"]
+    own_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    assert 0 < memory["footprint_mb"] < memory["total_mb"] + own_mb
 
 
 SHOUT = Path(__file__).parent / "fixtures" / "mini_course" / "assignments" / "shout"

@@ -207,7 +207,8 @@ def test_urdu_html_report_is_right_to_left():
 def test_the_results_file_reads_back_with_its_timing_memory_and_pacing():
     """A batch resuming from its reports, and the proofs' diagnoses, read these back."""
     data = {"isolation": {"mode": "strict"}, "timing": {"total": 9.1, "modules": {}},
-            "memory": {"grader_mb": 90.0, "student_mb": 80.0, "total_mb": 170.0},
+            "memory": {"grader_mb": 90.0, "student_mb": 80.0, "total_mb": 170.0,
+                       "footprint_mb": 120.5},
             "pacing": {"test_a.py": {"idle": 10, "late_deliveries": 1}},
             "warnings": ["w"], "bags": {"test_a.py": "a.mcap"}}
     written = json.loads(to_json(dataclasses.replace(result(), data=data)))

@@ -3,6 +3,7 @@ numbers) and one grading of parameter_validation's reference whose results file 
 
 from __future__ import annotations
 
+import resource
 import threading
 
 import pytest
@@ -97,3 +98,7 @@ def test_a_grading_says_where_its_seconds_and_memory_went() -> None:
     assert timing["child_start"] + timing["tests"] <= timing["total"]
     assert memory["grader_mb"] > 0 and memory["student_mb"] > 0
     assert memory["total_mb"] == pytest.approx(memory["grader_mb"] + memory["student_mb"])
+    # The tree's PSS: this process, the child and a student at a time, each counting at
+    # most its resident size (PSS divides the pages it shares), so under their peaks.
+    own_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    assert 0 < memory["footprint_mb"] <= memory["total_mb"] + own_mb

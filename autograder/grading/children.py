@@ -24,6 +24,7 @@ from pathlib import Path
 from autograder.core import report
 from autograder.core.report import RawReport, RawTest
 from autograder.core.settings import RunSettings
+from autograder.grading.footprint import Footprint
 from autograder.sandbox.domains import DomainLock
 from autograder.sandbox.process import reap_recorded
 
@@ -121,13 +122,18 @@ def started(prefix: Sequence[str], settings: RunSettings, targets: Sequence[str]
         os.close(life_write)
 
 
-def wait(children: Sequence[Child], limit: float, watchers: Watchers) -> None:
+def wait(children: Sequence[Child], limit: float, watchers: Watchers,
+         footprint: Footprint | None = None) -> None:
     """Wait for every child, telling ``watchers`` as tests run and finish; a child still
-    running ``limit`` seconds from now is stopped (``timed_out``) with all it started."""
+    running ``limit`` seconds from now is stopped (``timed_out``) with all it started.
+    ``footprint``, if given, samples the grading's memory meanwhile (it keeps to its own
+    interval, every fourth of these wake-ups)."""
     deadline = time.monotonic() + limit
     reported: set[str] = set()
     while True:
         live = [c for c in children if c.process.poll() is None]
+        if live and footprint is not None:
+            footprint.sample()
         if live:
             with contextlib.suppress(subprocess.TimeoutExpired):
                 live[0].process.wait(timeout=0.25)

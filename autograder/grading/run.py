@@ -27,6 +27,7 @@ from autograder.core.settings import RunSettings
 from autograder.grading import children
 from autograder.grading.capacity import machine_cores
 from autograder.grading.children import Progress, Watchers
+from autograder.grading.footprint import Footprint
 from autograder.grading.modules import ModuleJobs, children_for, find_modules, merge, share_out
 from autograder.i18n import _, get_language
 from autograder.sandbox.domains import DomainLock, NoDomain, hold_domain
@@ -179,15 +180,29 @@ def _run(exercise: Exercise, submission: Path | None, plan: _Plan,
                     run_prefix(isolation), dataclasses.replace(settings, count_only=count_only),
                     [str(t) for t in group], Path(tmp) / f"child-{index}", exercise.folder,
                     lock)))
-            children.wait(running, exercise.time_limit, watchers)
+            footprint = Footprint([child.process.pid for child in running])
+            children.wait(running, exercise.time_limit, watchers, footprint)
         ended = [children.end(child) for child in running]
     elapsed = time.monotonic() - started
     raw = merge(([e.raw for e in ended]), plan.order(exercise.folder))
     result = _result(exercise, raw, ended, elapsed, all_tests=plan.all_tests)
     timing = _timing(raw.data, min(e.launched for e in ended), elapsed)
+    memory = _memory(raw.data.get("memory"), footprint.peak_mb)
     return dataclasses.replace(result, data={
         **result.data, "timing": {**timing, "children": len(ended)},
-        **({"memory": raw.data["memory"]} if raw.data.get("memory") else {})}), raw
+        **({"memory": memory} if memory else {})}), raw
+
+
+def _memory(children_peaks: dict[str, float] | None,
+            footprint_mb: float | None) -> dict[str, float]:
+    """The results' ``memory``: the children's peak resident sizes, summed (an upper bound,
+    see :func:`autograder.grading.modules.merge`), and ``footprint_mb``, the peak of the
+    whole grading's summed PSS as sampled (:mod:`autograder.grading.footprint`), if any
+    sample was taken."""
+    memory = dict(children_peaks or {})
+    if footprint_mb is not None:
+        memory["footprint_mb"] = footprint_mb
+    return memory
 
 
 def _timing(data: dict[str, Any], launched: float, elapsed: float) -> dict[str, Any]:
