@@ -16,9 +16,14 @@ RST = re.compile(r"``|:[a-z]+:`|`_\b|^\s*\.\. ", re.MULTILINE)
 
 
 def _commands(command: click.Command, path: tuple[str, ...] = ()) -> Iterator[tuple[str, ...]]:
+    """Every command's path, asked the way click asks (the lazy ``sim``, ``quiz`` and
+    ``i18n`` groups are imported only then)."""
     yield path
     if isinstance(command, click.Group):
-        for name, sub in command.commands.items():
+        ctx = click.Context(command)
+        for name in command.list_commands(ctx):
+            sub = command.get_command(ctx, name)
+            assert sub is not None, name
             yield from _commands(sub, (*path, name))
 
 
