@@ -128,7 +128,8 @@ def observe(probe, world, streams: Streams, end_at: float = END_AT,
         switch_at = max(switch_at, probe.now)
         world.schedule_real_time_factor(switch_at, OTHER_RTF)
         world.schedule_real_time_factor(end, pace)
-    slowest = min(pace, rtf or pace, OTHER_RTF if switch_at is not None else pace)
+    watched = rtf or pace
+    slowest = watched if switch_at is None else min(watched, OTHER_RTF)
     try:
         start = max(streams.started, commands.times[0]) + SETTLE
         probe.wait_for(lambda: probe.now >= start, SETTLE + 1.0)
@@ -137,7 +138,7 @@ def observe(probe, world, streams: Streams, end_at: float = END_AT,
         world.cancel_scheduled_pace()
         world.set_real_time_factor(pace)
     switched = [] if switch_at is None else [
-        t for t, rtf in world.pace_changes if t >= switch_at - 1e-9 and rtf == OTHER_RTF]
+        t for t, to in world.pace_changes if t >= switch_at - 1e-9 and to == OTHER_RTF]
     switch = switched[0] if switched else None
     if frozen is None:
         _let_in_flight_arrive(probe, commands, end)
