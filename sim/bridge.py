@@ -182,10 +182,16 @@ class SimBridge:
             self.pacer.set_real_time_factor(rtf)
             self.pace_changes.append((now, rtf))
 
-    def inject(self, fault: Fault) -> None:
-        """Add a fault at run time."""
+    def inject(self, fault: Fault) -> float:
+        """Add a fault at run time; return the sim time it was added at, between ticks.
+
+        Every message published at a later sim time reflects the fault (from its
+        ``start``). Sim time read before the call does not say that: a tick may be under
+        way (its steps advance :attr:`now` before it publishes), and it finishes first.
+        """
         with self._cond:
             self.sim.inject(fault)
+            return self.world.time
 
     def add_tap(self, tap: Callable[[str, str, Any, float], None]) -> None:
         """Hand every message published or received to ``tap(topic, type name, message,

@@ -321,7 +321,8 @@ def without_both_types(result: RunResult) -> dict[str, str]:
 def test_reference_scores_full_marks_every_time(graded: dict[str, RunResult],
                                                 proof: Proof) -> None:
     results = [graded[f"reference#{i}"] for i in range(proof.repeats)]
-    assert [r.grader_error for r in results] == [None] * proof.repeats
+    assert [r.grader_error for r in results] == [None] * proof.repeats, explain(
+        runs=[diagnosis(r) for r in results])
     assert all(r.score == r.max_score for r in results), explain(
         runs=[diagnosis(r) for r in results])
     assert len({r.max_score for r in results}) == 1
@@ -330,7 +331,7 @@ def test_reference_scores_full_marks_every_time(graded: dict[str, RunResult],
 
 def test_starter_is_below_the_pass_mark(graded: dict[str, RunResult]) -> None:
     result = graded["starter"]
-    assert result.grader_error is None
+    assert result.grader_error is None, explain(**diagnosis(result))
     assert not result.passed
     assert result.score < result.max_score * result.pass_mark
 
@@ -338,7 +339,7 @@ def test_starter_is_below_the_pass_mark(graded: dict[str, RunResult]) -> None:
 def test_other_correct_designs_score_full_marks(graded: dict[str, RunResult],
                                                 correct: str) -> None:
     result = graded[correct]
-    assert result.grader_error is None
+    assert result.grader_error is None, explain(**diagnosis(result))
     assert result.score == result.max_score, explain(**diagnosis(result))
 
 
@@ -348,7 +349,7 @@ def test_known_bad_variant_loses_exactly_the_tests_aimed_at_it(
     than its name says, or at a flaw other than the one its folder names."""
     result = graded[known_bad]
     variant = proof.variants[known_bad]
-    assert result.grader_error is None
+    assert result.grader_error is None, explain(**diagnosis(result))
     assert result.score < result.max_score
     lost = failed_tests(result)
     assert variant.loses <= lost <= variant.loses | variant.may_also_lose, explain(

@@ -59,7 +59,7 @@ def test_references_score_full_marks(batch) -> None:
 
 def test_starter_is_below_the_pass_mark(batch) -> None:
     _proof, results, jobs = batch
-    assert results["starter"].grader_error is None
+    assert results["starter"].grader_error is None, explain(**diagnosis(results["starter"]))
     assert not results["starter"].passed, jobs
 
 

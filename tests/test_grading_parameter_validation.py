@@ -9,7 +9,7 @@ score and a plain message.
 from __future__ import annotations
 
 import pytest
-from proving import Proof, failed_tests, without_both_types
+from proving import Proof, diagnosis, explain, failed_tests, without_both_types
 
 pytestmark = pytest.mark.slow
 
@@ -23,14 +23,14 @@ def test_reference_max_score_is_the_exercise_points(graded):
 
 def test_syntax_error_is_named_with_its_line(graded):
     result = graded["syntax_error"]
-    assert result.grader_error is None
+    assert result.grader_error is None, explain(**diagnosis(result))
     assert result.score == 0
     assert all("velocity_governor.py, line" in t.message for t in result.tests)
 
 
 def test_crash_at_start_scores_zero_with_its_traceback(graded):
     result = graded["crash_at_start"]
-    assert result.grader_error is None
+    assert result.grader_error is None, explain(**diagnosis(result))
     assert result.score == 0
     message = result.tests[0].message
     # The same words whether or not discovery showed the node before the crash (it is
@@ -51,7 +51,7 @@ def test_wrong_node_name_is_reported_with_the_names_seen(graded):
 
 def test_node_that_never_spins_fails_what_needs_spinning(graded):
     result = graded["never_spins"]
-    assert result.grader_error is None
+    assert result.grader_error is None, explain(**diagnosis(result))
     assert not result.passed
     by_name = {t.name: t for t in result.tests}
     for name in ("test_clamps_linear", "test_refuses_out_of_range"):

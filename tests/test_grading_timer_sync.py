@@ -13,7 +13,7 @@ import re
 
 import pytest
 from designs import read_design
-from proving import Proof, without_both_types
+from proving import Proof, diagnosis, explain, without_both_types
 
 from autograder.core.exercise import find_exercise
 from autograder.render.html import to_html
@@ -44,7 +44,8 @@ def departures_from_the_chapter(source: str) -> list[str]:
 def test_chapter_design_is_the_reference(graded, proof):
     """The reference, which must score 100% every time, is the chapter's own design."""
     assert graded["reference#0"].max_score == 14
-    assert all(graded[f"reference#{i}"].score == 14 for i in range(proof.repeats))
+    assert all(graded[f"reference#{i}"].score == 14 for i in range(proof.repeats)), explain(
+        runs=[diagnosis(graded[f"reference#{i}"]) for i in range(proof.repeats)])
     exercise = find_exercise("timer_sync")
     assert departures_from_the_chapter(exercise.solution.read_text()) == []
     # The check tells the design from others: each departs from it in its own way.

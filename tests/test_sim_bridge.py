@@ -26,7 +26,7 @@ from sensor_msgs.msg import LaserScan
 
 from sim.bridge import SimBridge
 from sim.physics import World
-from sim.worldfile import Box, load_world
+from sim.worldfile import Box, Fault, load_world
 
 WALL = 20.0  # generous wall-clock deadline for any one condition
 
@@ -283,3 +283,41 @@ def test_student_process_stops_before_wall(tmp_path, graph: tuple[SimBridge, Pro
         bridge.watch_pid(None)
         student.terminate()
         student.wait(timeout=WALL)
+
+
+def test_inject_says_from_when_messages_show_the_fault(
+        graph: tuple[SimBridge, Probe]) -> None:
+    """A fault added while a tick is under way (here by a tap, between that tick's /clock
+    and its /scan, which was computed before) shows from the next tick on: inject()
+    returns the sim time after which every message has it, not the one read before.
+    Last in the module: the box stays in the bridge's world (faults are never removed)."""
+    bridge, _probe = graph
+    bridge.reset()  # in the open room, away from the wall an earlier test drove to
+    x, y, theta = bridge.world.pose
+    box = Box(center=(x + 0.4 * math.cos(theta), y + 0.4 * math.sin(theta)), size=(0.1, 0.6))
+    armed = False
+    added: list[float] = []
+    scans: list[tuple[float, float]] = []  # (sim time, nearest reading)
+
+    def tap(topic: str, _type: str, message: object, t: float) -> None:
+        nonlocal armed
+        if topic == "/clock" and armed:
+            armed = False
+            added.append(bridge.inject(Fault(kind="obstacle", start=t - 0.05, end=t + 0.5,
+                                             box=box)))
+        elif topic == "/scan" and added:
+            scans.append((t, min(message.ranges)))  # type: ignore[attr-defined]
+
+    bridge.add_tap(tap)
+    bridge.pause()
+    try:
+        armed = True
+        bridge.step(20)  # 0.1 s: one scan, taken before the tap adds the box
+        bridge.step(20)
+    finally:
+        bridge.resume()
+    assert added == [pytest.approx(bridge.now - 0.1)]
+    (before, nearest_before), (after, nearest_after) = scans[:2]
+    assert before <= added[0] < after
+    assert nearest_before > 1.0  # the open room: the box was added after this scan
+    assert nearest_after == pytest.approx(0.35, abs=0.03)  # its near face

@@ -84,7 +84,7 @@ def test_a_grading_says_where_its_seconds_and_memory_went() -> None:
     # One child, so its tests' seconds add up within the total (children at once
     # overlap: tests/test_modules.py).
     result = grade(find_exercise("parameter_validation"), None, module_jobs=1)
-    assert result.grader_error is None
+    assert result.grader_error is None, result.grader_details
     data = result.to_dict()
     timing, memory = data["timing"], data["memory"]
     modules = {t.data["nodeid"].split("::")[0] for t in result.tests}
