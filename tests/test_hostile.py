@@ -13,6 +13,7 @@ import shutil
 import socket
 import subprocess
 import sys
+import tempfile
 import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -27,6 +28,7 @@ from autograder.grading.run import grade
 from autograder.render.terminal import to_terminal
 from autograder.sandbox.isolation import detect
 from autograder.sandbox.leftovers import leftovers
+from autograder.sandbox.process import STRICT_WORKDIR_PREFIX
 
 pytestmark = pytest.mark.slow
 
@@ -94,15 +96,35 @@ def target_host():
         received.unlink(missing_ok=True)
 
 
+def student_folders() -> set[Path]:
+    """The folders of students' programs in strict isolation, in the temporary folder."""
+    return set(Path(tempfile.gettempdir()).glob(f"{STRICT_WORKDIR_PREFIX}*"))
+
+
 @pytest.fixture(scope="module")
-def graded(course, target_host) -> dict[str, tuple[RunResult, float, list[int]]]:
+def corpus_run(course, target_host) -> tuple[dict[str, tuple[RunResult, float, list[int]]],
+                                             list[Path]]:
+    """Every submission of the corpus graded (two at a time), and the folders of
+    students' programs that the gradings left in the temporary folder."""
     def run(name: str) -> tuple[str, tuple[RunResult, float, list[int]]]:
         began = time.monotonic()
         result = grade(course, CORPUS / name)
         return name, (result, time.monotonic() - began, leftovers(result))
 
+    before = student_folders()
     with ThreadPoolExecutor(max_workers=2) as pool:
-        return dict(pool.map(run, NAMES))
+        graded = dict(pool.map(run, NAMES))
+    return graded, sorted(student_folders() - before)
+
+
+@pytest.fixture(scope="module")
+def graded(corpus_run) -> dict[str, tuple[RunResult, float, list[int]]]:
+    return corpus_run[0]
+
+
+def test_no_folder_is_left_behind(corpus_run):
+    """Nor a folder: a program's own (strict isolation) goes when it is stopped."""
+    assert corpus_run[1] == []
 
 
 def messages(result: RunResult) -> str:

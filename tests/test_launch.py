@@ -26,7 +26,12 @@ from autograder.sandbox.isolation import (
     dds_env,
     detect,
 )
-from autograder.sandbox.process import LaunchFailed, student_process
+from autograder.sandbox.process import (
+    STRICT_WORKDIR_PREFIX,
+    LaunchFailed,
+    reap_recorded,
+    student_process,
+)
 
 REPO = Path(__file__).resolve().parent.parent
 COURSE = REPO / "tests" / "fixtures" / "mini_course"
@@ -240,3 +245,24 @@ def test_refused_namespaces_are_named_as_the_reason():
                          env=dict(os.environ, PYTHONPATH=str(REPO)), timeout=120)
     assert run.stdout.strip() == ("basic namespaces are not allowed here (an unprivileged "
                                   "container?)"), run.stderr
+
+
+def test_reaping_a_record_removes_the_strict_folder_it_names_and_no_other(tmp_path):
+    """A run killed before its fixtures stop the program (the time limit, a wait that
+    raised) leaves the strict folder in the temporary folder: the parent's reaping, from the
+    run's report, removes it; a record naming any other folder removes nothing."""
+    strict = Path(tempfile.mkdtemp(prefix=STRICT_WORKDIR_PREFIX))
+    (strict / ".ros").mkdir()
+    (strict / "program.py").write_text("print()\n")
+    elsewhere = tmp_path / f"{STRICT_WORKDIR_PREFIX}not-in-tmp"
+    elsewhere.mkdir()
+    other = Path(tempfile.mkdtemp(prefix="not-a-student-"))
+    try:
+        for folder in (elsewhere, other, strict):
+            # pid 0 would signal our own group: a pid that is surely gone instead.
+            reap_recorded({"pid": 2 ** 22 + 1, "cgroups": [], "workdir": str(folder)})
+        assert not strict.exists()
+        assert elsewhere.is_dir() and other.is_dir()
+    finally:
+        shutil.rmtree(strict, ignore_errors=True)
+        shutil.rmtree(other, ignore_errors=True)

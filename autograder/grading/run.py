@@ -71,7 +71,8 @@ def grade(exercise: Exercise, submission: Path | None, *, hidden: bool = True,
     if warnings:
         result = dataclasses.replace(result, data={
             **result.data, "warnings": warnings + result.data.get("warnings", [])})
-    processes = raw.processes
+    # Where each ran on this machine is the reaping's business, not the results'.
+    processes = [{k: v for k, v in p.items() if k != "workdir"} for p in raw.processes]
     bounds = processes[0].get("bounds") if processes else None
     first = locks[0].domain
     return dataclasses.replace(result, data={

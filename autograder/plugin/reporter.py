@@ -78,10 +78,14 @@ class GradingReporter:
             report.keep_log(self.path, self.data, nodeid, text)
         self.write()
 
-    def note_process(self, pid: int, cgroups: list[str], bounds: dict[str, Any]) -> None:
-        """Record a student process so the parent can reap it if this run is killed, and
-        say which bounds held it."""
-        self.data["processes"].append({"pid": pid, "cgroups": cgroups, "bounds": bounds})
+    def note_process(self, pid: int, cgroups: list[str], bounds: dict[str, Any],
+                     workdir: str | None = None) -> None:
+        """Record a student process so the parent can reap it if this run is killed (and
+        remove its folder outside the run's, ``workdir``), and say which bounds held it."""
+        record = {"pid": pid, "cgroups": cgroups, "bounds": bounds}
+        if workdir is not None:
+            record["workdir"] = workdir
+        self.data["processes"].append(record)
         self.write()
 
     @pytest.hookimpl(trylast=True)

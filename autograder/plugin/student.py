@@ -46,6 +46,7 @@ class StudentNode:
         # The program runs from a throwaway folder; its tracebacks name the student's own
         # folder instead ("" for the file's bare name), line numbers as they are.
         self.shown_folder = shown_folder
+        self._stopped = False
 
     @property
     def returncode(self) -> int | None:
@@ -77,12 +78,18 @@ class StudentNode:
         self.process.signal(sig)
 
     def stop(self) -> int | None:
+        """Stop the program (SIGINT, then SIGKILL) and remove its folder; once: a later call
+        (the module's fixture after a test or a failed start did) only says how it ended,
+        and signals no process group whose id may since be another's."""
+        if self._stopped:
+            return self.process.returncode
+        self._stopped = True
         self.probe.world.closing_pid(self.process.pid)
         status = self.process.stop()
         self.probe.world.unwatch_pid(self.process.pid)
         if self.process.uid is not None:  # strict: our own folder in /tmp, not the run's
             shutil.rmtree(self.process.workdir, ignore_errors=True)
-        if self.on_stop is not None:  # once: a failed start stops it before the fixture does
+        if self.on_stop is not None:
             on_stop, self.on_stop = self.on_stop, None
             on_stop(self)
         return status
@@ -129,7 +136,8 @@ def _launch(request: pytest.FixtureRequest, exercise: Exercise, script: Path, pr
             process.pid, [str(p) for p in process.cgroup.paths],
             # RLIMIT_NPROC binds every user but root: a uid of the student's own, or an
             # ordinary grading user (where it counts that user's other processes too).
-            process.cgroup.bounds(separate_uid=process.uid is not None or os.geteuid() != 0))
+            process.cgroup.bounds(separate_uid=process.uid is not None or os.geteuid() != 0),
+            str(process.workdir) if process.uid is not None else None)
     process.start()
     world.watch_pid(process.pid)
     node = StudentNode(process, exercise.node, probe, _log_keeper(request),
@@ -141,8 +149,11 @@ def _launch(request: pytest.FixtureRequest, exercise: Exercise, script: Path, pr
             raise StudentFailure(earlier.message, earlier.hint)
         try:
             _wait_for_node(exercise, node, world, stale)
-        except NodeNeverAppeared as failure:
+        except NodeNeverAppeared as failure:  # stopped already
             request.config.stash[startup_key] = failure
+            raise
+        except BaseException:  # a wait that raised: nothing may outlive it
+            node.stop()
             raise
         if reporter is not None:
             reporter.data.setdefault("startup_seconds", []).append(node.startup_seconds)
@@ -228,14 +239,15 @@ def student(request: pytest.FixtureRequest, exercise: Exercise, submission_file:
     marker = request.node.get_closest_marker("parameters")
     node = launch(request, exercise, submission_file, probe, world,
                   marker.args[0] if marker and marker.args else None)
-    # A program that creates its node and quits at once must fail the same way every time,
-    # whether or not we saw the node in between: watch it for a moment of sim time.
-    if probe.wait_for(lambda: not node.running(), STARTUP_SETTLE):
-        raise _exited_at_start(node, exercise)
     try:
+        # A program that creates its node and quits at once must fail the same way every
+        # time, whether or not we saw the node in between: watch it for a moment of sim
+        # time (a wait that may raise: a node that keeps the machine too busy).
+        if probe.wait_for(lambda: not node.running(), STARTUP_SETTLE):
+            raise _exited_at_start(node, exercise)
         yield node
     finally:
-        node.stop()
+        node.stop()  # also its folder, whichever way the module ends
 
 
 @pytest.fixture

@@ -14,6 +14,7 @@ import dataclasses
 import json
 import os
 import select
+import shutil
 import signal
 import subprocess
 import sys
@@ -39,6 +40,10 @@ STUDENT_PROFILE = ".fastdds_profile.xml"
 """The name of the student's copy of the Fast DDS profile in its working directory."""
 
 
+# The folders of students' programs in strict isolation, in the system's temporary folder.
+STRICT_WORKDIR_PREFIX = "autograder-student-"
+
+
 def student_process(script: Path, ros_args: list[str], limits: Limits, *, domain: int,
                     strict: bool, course: Path) -> StudentProcess:
     """The student's program as every launch prepares it: a copy of ``script`` and its
@@ -59,7 +64,7 @@ def student_process(script: Path, ros_args: list[str], limits: Limits, *, domain
 
     # Strict: a folder outside the grader's (0700) run folder, turned into the student's
     # own tmpfs by the launcher. Basic: a throwaway folder beside the staged copy.
-    workdir = Path(tempfile.mkdtemp(prefix="autograder-student-" if strict else "student-",
+    workdir = Path(tempfile.mkdtemp(prefix=STRICT_WORKDIR_PREFIX if strict else "student-",
                                     dir=None if strict else script.parent.parent))
     for source in script.parent.glob("*.py"):
         (workdir / source.name).write_bytes(source.read_bytes())
@@ -82,12 +87,24 @@ def student_python() -> str:
 
 def reap_recorded(record: dict[str, Any]) -> None:
     """Kill a student process known only by its record in the raw report (``pid`` and
-    ``cgroups``), from another process: its process group and everything in its cgroups."""
+    ``cgroups``), from another process: its process group and everything in its cgroups;
+    then remove its folder in strict isolation (``workdir``), which the run that started it
+    removes when it stops the program, but not when the run itself is killed."""
     with contextlib.suppress(ProcessLookupError, PermissionError):
         os.killpg(record["pid"], signal.SIGKILL)
     group = Cgroup.existing(record.get("cgroups", []))
     group.kill_all()
     group.remove()
+    workdir = record.get("workdir")
+    if isinstance(workdir, str) and is_strict_workdir(Path(workdir)):
+        shutil.rmtree(workdir, ignore_errors=True)
+
+
+def is_strict_workdir(path: Path) -> bool:
+    """Whether ``path`` is a folder :func:`student_process` makes in strict isolation (the
+    only ones a report may name for removal)."""
+    return (path.parent == Path(tempfile.gettempdir())
+            and path.name.startswith(STRICT_WORKDIR_PREFIX) and not path.is_symlink())
 
 
 def minimal_env(workdir: Path, extra: dict[str, str | None]) -> dict[str, str]:
