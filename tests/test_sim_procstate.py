@@ -11,7 +11,7 @@ from collections.abc import Iterator
 import pytest
 
 from sim.pacing import DEFAULT_CPU_BUDGET
-from sim.procstate import IDLE, process_busy, read_process_state
+from sim.procstate import IDLE, ProcessStateReader, process_busy, read_process_state
 
 WALL = 20.0
 
@@ -94,3 +94,72 @@ def test_a_starved_process_is_busy_but_gets_no_cpu() -> None:
     assert all(s.busy for s in samples)
     # At this rate it would not use its CPU budget within the 2 s cap of a hold.
     assert used < DEFAULT_CPU_BUDGET * 1e9 / 4, used
+
+
+# A process whose thread count changes on command: a line "+" starts a thread that blocks,
+# "-" ends the newest; each answers with the count of threads it now has.
+THREADS = [sys.executable, "-c", """\
+import sys, threading
+stops = []
+for line in sys.stdin:
+    if line.strip() == "+":
+        stop = threading.Event()
+        thread = threading.Thread(target=stop.wait)
+        thread.start()
+        stops.append((stop, thread))
+    elif line.strip() == "-":
+        stop, thread = stops.pop()
+        stop.set()
+        thread.join()
+    print(threading.active_count(), flush=True)
+for stop, _ in stops:
+    stop.set()
+"""]
+
+
+def _open_fds() -> int:
+    return len(os.listdir("/proc/self/fd"))
+
+
+def test_the_reader_keeping_files_open_reads_what_opening_them_reads() -> None:
+    """ProcessStateReader (the pacing's) follows threads that start and end, and closes
+    what it kept for a process once it is gone or forgotten."""
+    proc = subprocess.Popen(THREADS, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+    assert proc.stdin is not None and proc.stdout is not None
+    reader = ProcessStateReader()
+    fds = _open_fds()
+
+    def command(line: str) -> int:
+        proc.stdin.write(line + "\n")
+        proc.stdin.flush()
+        return int(proc.stdout.readline())
+
+    try:
+        assert _poll(lambda: not reader(proc.pid).busy)
+        for line, threads in (("+", 2), ("+", 3), ("-", 2), ("-", 1), ("+", 2)):
+            assert command(line) == threads
+            assert _poll(lambda n=threads: len(os.listdir(f"/proc/{proc.pid}/task")) == n)
+            # Once idle, the two readings agree (nothing moves between them).
+            assert _poll(lambda: reader(proc.pid) == read_process_state(proc.pid))
+            assert reader(proc.pid).exists and reader(proc.pid).cpu_ns > 0
+            assert _open_fds() == fds + 2 * threads  # two files a thread, the ended closed
+        reader.forget(proc.pid)
+        assert _open_fds() == fds
+        assert reader(proc.pid).exists
+    finally:
+        proc.kill()
+        proc.wait()
+    assert reader(proc.pid) == IDLE
+    assert _open_fds() == fds
+
+
+def test_the_reader_keeps_few_files_and_none_once_closed(spinner: subprocess.Popen[str]) -> None:
+    reader = ProcessStateReader(max_threads=0)  # every thread read the slow way
+    fds = _open_fds()
+    state = reader(spinner.pid)
+    assert state.busy and state.cpu_ns > 0 and _open_fds() == fds
+    reader = ProcessStateReader()
+    assert reader(spinner.pid).busy and _open_fds() == fds + 2
+    reader.close()
+    assert _open_fds() == fds
+    assert reader(spinner.pid).busy and _open_fds() == fds  # closed: read the slow way
