@@ -136,10 +136,13 @@ def _collected(folder: Path) -> list[str]:
 
 
 @pytest.mark.slow
-def test_a_grading_runs_its_modules_in_two_children_on_two_domains() -> None:
+def test_a_grading_runs_its_modules_in_two_children_on_two_domains(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     from autograder.core.exercise import find_exercise
     from autograder.grading.run import grade
 
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    monkeypatch.setenv("PYTHONDONTWRITEBYTECODE", "1")  # the children cache theirs anyway
     exercise = find_exercise("parameter_validation")
     result = grade(exercise, None, module_jobs=2)
     assert result.grader_error is None, result.grader_details
@@ -157,6 +160,25 @@ def test_a_grading_runs_its_modules_in_two_children_on_two_domains() -> None:
     memory = result.data["memory"]
     own_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     assert 0 < memory["footprint_mb"] < memory["total_mb"] + own_mb
+    # The children kept their bytecode (hidden tests' included) in the user's cache, and
+    # wrote none beside the course's sources.
+    cached = tmp_path / "rclpy-autograder" / "pycache"
+    hidden = next((exercise.folder / "tests" / "hidden").glob("test_*.py"))
+    assert list((cached / hidden.parent.relative_to("/")).glob(f"{hidden.stem}.*.pyc"))
+    assert not list(exercise.folder.rglob("__pycache__"))
+
+
+def test_children_write_no_bytecode_where_the_cache_cannot_be_made(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from autograder.grading.children import bytecode_env
+
+    (tmp_path / "rclpy-autograder").write_text("a file where the folder would go")
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    env = bytecode_env({"PYTHONPYCACHEPREFIX": "/elsewhere", "PATH": "/usr/bin"})
+    assert env == {"PYTHONDONTWRITEBYTECODE": "1", "PATH": "/usr/bin"}
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    env = bytecode_env({"PYTHONDONTWRITEBYTECODE": "1"})
+    assert env == {"PYTHONPYCACHEPREFIX": str(tmp_path / "cache" / "rclpy-autograder" / "pycache")}
 
 
 SHOUT = Path(__file__).parent / "fixtures" / "mini_course" / "assignments" / "shout"

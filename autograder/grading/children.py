@@ -87,6 +87,33 @@ class Ended:
             not self.raw.forged and not self.raw.tests)
 
 
+def bytecode_cache() -> Path:
+    """Where child pytests keep their compiled modules: a cache folder of this user's."""
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "rclpy-autograder" / "pycache"
+
+
+def bytecode_env(env: dict[str, str]) -> dict[str, str]:
+    """``env`` for a child pytest: compiled modules (the grader's, the exercise's tests)
+    kept in :func:`bytecode_cache`, never beside the sources, so no bytecode of hidden tests
+    lands in the course; where that folder cannot be made, none written at all.  Each
+    child then starts without compiling what the one before it compiled."""
+    env = dict(env)
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
+    try:
+        cache = bytecode_cache()
+        cache.mkdir(mode=0o700, parents=True, exist_ok=True)
+        usable = os.access(cache, os.W_OK | os.X_OK)
+    except (OSError, RuntimeError):  # RuntimeError: no home folder to be found
+        usable = False
+    if usable:
+        env["PYTHONPYCACHEPREFIX"] = str(cache)
+    else:
+        env["PYTHONDONTWRITEBYTECODE"] = "1"
+        env.pop("PYTHONPYCACHEPREFIX", None)
+    return env
+
+
 @contextlib.contextmanager
 def started(prefix: Sequence[str], settings: RunSettings, targets: Sequence[str],
             folder: Path, rootdir: Path, lock: DomainLock) -> Iterator[Child]:
@@ -104,7 +131,7 @@ def started(prefix: Sequence[str], settings: RunSettings, targets: Sequence[str]
         "--rootdir", str(rootdir), "--basetemp", str(folder / "pytest"),
         "--autograder-settings", settings.to_json(), *targets,
     ]
-    env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1")
+    env = bytecode_env(dict(os.environ))
     log_path = folder / "pytest.log"
     try:
         with log_path.open("wb") as log:
