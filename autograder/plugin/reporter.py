@@ -175,9 +175,13 @@ class GradingReporter:
 
 def peak_memory() -> dict[str, float]:
     """Peak resident memory in MB: this process (pytest, the world and the probe) and the
-    largest student process it has waited for (each started program is, when stopped)."""
+    largest student process it has waited for (each started program is, when stopped), or
+    its zygote has (:func:`autograder.sandbox.process.forked_peak_mb`)."""
+    from autograder.sandbox.process import forked_peak_mb
+
     grader = round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, 1)  # KB
-    student = round(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024, 1)
+    student = round(max(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024,
+                        forked_peak_mb()), 1)
     return {"grader_mb": grader, "student_mb": student, "total_mb": round(grader + student, 1)}
 
 

@@ -129,6 +129,45 @@ def minimal_env(workdir: Path, extra: dict[str, str | None]) -> dict[str, str]:
     return env
 
 
+_zygotes: dict[tuple[str, ...], Any] = {}
+_zygotes_lock = threading.Lock()
+_zygotes_failed = False
+
+
+def warm_start(python: str, env: dict[str, str]) -> Any:
+    """This process's zygote for programs run by ``python`` with ``env``
+    (:mod:`autograder.sandbox.zygote`), started at the first launch; None where launches
+    are exec'd: ``AUTOGRADER_ZYGOTE=0``, a zygote that failed or died in this process,
+    or an environment Python would start differently."""
+    global _zygotes_failed
+    from autograder.sandbox.zygote import STARTUP_VARIABLES, Zygote, ZygoteGone
+
+    if os.environ.get("AUTOGRADER_ZYGOTE", "1") == "0":
+        return None
+    key = (python, *(f"{k}={env.get(k)}" for k in STARTUP_VARIABLES))
+    with _zygotes_lock:
+        if _zygotes_failed:
+            return None
+        zygote = _zygotes.get(key)
+        if zygote is None:
+            try:
+                zygote = _zygotes[key] = Zygote(python, env, "/")
+            except ZygoteGone:
+                _zygotes_failed = True
+                return None
+        if not zygote.fits(env):  # it died: from here on, exec
+            _zygotes_failed = True
+            return None
+        return zygote
+
+
+def forked_peak_mb() -> float:
+    """The largest peak resident size, in MB, of the programs this process's zygotes forked
+    and reaped (what ``RUSAGE_CHILDREN`` tells of the programs it exec'd itself)."""
+    with _zygotes_lock:
+        return max((z.peak_kb for z in _zygotes.values()), default=0) / 1024
+
+
 class LaunchFailed(GraderError):
     """The launcher failed before the student's program ran: our fault, never theirs."""
 
@@ -199,7 +238,7 @@ class StudentProcess:
     ros_args: list[str]
     env: dict[str, str]
     limits: Limits
-    popen: subprocess.Popen[bytes] | None = None
+    popen: Any = None  # a subprocess.Popen, or a zygote's ForkedProcess
     cgroup: Cgroup | None = None
     output: _Output | None = None
     uid: int | None = None
@@ -216,32 +255,25 @@ class StudentProcess:
     _watchdog: threading.Timer | None = None
 
     def start(self) -> None:
-        """Start the program through the launcher; return once it is exec'd, or raise
-        :class:`LaunchFailed` if the launcher failed before that."""
+        """Start the program (forked from the zygote where there is one, else through the
+        launcher); return once it runs, or raise :class:`LaunchFailed` if what contains it
+        failed before that."""
         self.workdir.mkdir(parents=True, exist_ok=True)
         (self.workdir / ".ros" / "log").mkdir(parents=True, exist_ok=True)
         self.cgroup = Cgroup(f"run-{os.getpid()}-{uuid.uuid4().hex[:8]}", self.limits)
-        status_read, status_write = os.pipe()
         spec: dict[str, object] = {"limits": dataclasses.asdict(self.limits),
-                                   "cgroups": [str(p) for p in self.cgroup.paths],
-                                   "status_fd": status_write}
+                                   "cgroups": [str(p) for p in self.cgroup.paths]}
         if self.uid is not None:
             spec.update(uid=self.uid, hide=[str(p) for p in self.hide],
                         workdir=str(self.workdir), workdir_mb=self.workdir_mb)
-        command = [sys.executable, "-m", "autograder.sandbox.launcher", json.dumps(spec), "--",
-                   student_python(), str(self.script), "--ros-args", *self.ros_args]
+        args = ["--ros-args", *self.ros_args]
         self.output = _Output(self.limits.output_kb * 1024)
         launcher_env = dict(self.env)
         launcher_env["PYTHONPATH"] = os.pathsep.join(
             p for p in (str(Path(__file__).resolve().parents[2]), self.env.get("PYTHONPATH"))
             if p)
-        try:
-            self.popen = subprocess.Popen(
-                command, cwd=self.workdir, env=launcher_env, stdin=subprocess.DEVNULL,
-                stdout=subprocess.PIPE, stderr=subprocess.STDOUT, start_new_session=True,
-                pass_fds=(status_write,))
-        finally:
-            os.close(status_write)
+        started = self._fork(spec, args, launcher_env) or self._exec(spec, args, launcher_env)
+        self.popen, status_read = started
         self.started_at = time.monotonic()
         if self.on_spawn is not None:
             self.on_spawn()
@@ -257,6 +289,42 @@ class StudentProcess:
         self._watchdog = threading.Timer(self.limits.wall_seconds, self._out_of_time)
         self._watchdog.daemon = True
         self._watchdog.start()
+
+    def _fork(self, spec: dict[str, object], args: list[str],
+              env: dict[str, str]) -> tuple[Any, int] | None:
+        """The program forked from this process's zygote, and the read end of its status
+        pipe; None where there is no zygote for it (then it is exec'd)."""
+        from autograder.sandbox.zygote import ZygoteGone
+
+        zygote = warm_start(student_python(), env)
+        if zygote is None:
+            return None
+        status_read, status_write = os.pipe()
+        try:
+            return zygote.spawn(spec, str(self.script), args, env, str(self.workdir),
+                                status_write), status_read
+        except ZygoteGone:
+            os.close(status_read)
+            return None
+
+    def _exec(self, spec: dict[str, object], args: list[str],
+              env: dict[str, str]) -> tuple[Any, int]:
+        """The program started through the launcher, which execs it once contained."""
+        status_read, status_write = os.pipe()
+        spec = {**spec, "status_fd": status_write}
+        command = [sys.executable, "-m", "autograder.sandbox.launcher", json.dumps(spec), "--",
+                   student_python(), str(self.script), *args]
+        try:
+            popen = subprocess.Popen(
+                command, cwd=self.workdir, env=env, stdin=subprocess.DEVNULL,
+                stdout=subprocess.PIPE, stderr=subprocess.STDOUT, start_new_session=True,
+                pass_fds=(status_write,))
+        except BaseException:
+            os.close(status_read)
+            raise
+        finally:
+            os.close(status_write)
+        return popen, status_read
 
     def _out_of_time(self) -> None:
         if self.running():

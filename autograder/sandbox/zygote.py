@@ -1,0 +1,383 @@
+"""A warm start for students' programs: a process that has imported rclpy once and forks
+each program from there, so a launch skips Python's start and the imports (about 0.3
+CPU-seconds of the 0.45 an rclpy program spends before its node exists).
+
+    python -s -m autograder.sandbox.zygote FD
+
+FD is one end of a ``SOCK_SEQPACKET`` socket pair; the grader (:class:`Zygote`) holds the
+other.  The zygote imports what students' nodes import, says ``ready``, and then for each
+request forks a child that does what :mod:`autograder.sandbox.launcher` does before its
+``exec`` (its own session, the environment and working folder asked for, output on the
+pipe handed over, then :func:`~autograder.sandbox.launcher.contain`: cgroups, limits, and in
+strict isolation the mount namespace and the student's user) and then runs the program as
+``python SCRIPT ARGS...`` would, as the interpreter's main program.  The zygote tells the
+grader each child's pid, and its wait status and peak resident size once it has exited.
+
+The zygote holds nothing of the grader's: it is started from a clean environment, never
+sees the course's tests, the report's key or the grader's files, and is single-threaded
+but for LTTng's listener threads (OpenBLAS is held to one thread, so numpy starts none),
+whose library is told of each fork as it asks (:func:`_fork_with_hooks`).  It
+ends when the grader's end of the socket closes, and with the grader's process
+(its socket's end closes however the grader ends).
+"""
+
+from __future__ import annotations
+
+import array
+import contextlib
+import json
+import os
+import select
+import signal
+import socket
+import subprocess
+import sys
+import threading
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
+
+from autograder.sandbox.launcher import LAUNCH_FAILED, contain
+
+# What students' nodes import (the chapter's exercises and the book's code): imported once
+# here instead of in every program.  A missing one is skipped.
+WARM_MODULES = (
+    "numpy", "rclpy", "rclpy.node", "rclpy.executors", "rclpy.callback_groups", "rclpy.qos",
+    "rclpy.parameter", "rclpy.duration", "rclpy.time", "rclpy.action",
+    "rcl_interfaces.msg", "std_msgs.msg", "std_srvs.srv", "geometry_msgs.msg",
+    "sensor_msgs.msg", "nav_msgs.msg", "rosgraph_msgs.msg",
+)
+# Variables Python reads when it starts, not afterwards: a launch whose environment differs
+# from the zygote's in one of them is started the ordinary way (see :meth:`Zygote.fits`).
+STARTUP_VARIABLES = (
+    "PYTHONPATH", "PYTHONUNBUFFERED", "PYTHONDONTWRITEBYTECODE", "PYTHONHASHSEED",
+    "PYTHONIOENCODING", "LANG", "LC_ALL", "LC_CTYPE", "MALLOC_ARENA_MAX", "LD_LIBRARY_PATH",
+)
+MAX_MESSAGE = 1 << 20
+
+
+# -- the zygote ----------------------------------------------------------------------
+def _send(sock: socket.socket, message: Mapping[str, object]) -> None:
+    sock.send(json.dumps(message).encode())
+
+
+def _warm() -> None:
+    for name in WARM_MODULES:
+        with contextlib.suppress(Exception):
+            __import__(name)
+
+
+def serve(fd: int) -> tuple[str, list[str]]:
+    """Serve the grader until its socket closes (then exit); return only in a forked child,
+    contained, with the script to run and its arguments."""
+    sock = socket.socket(fileno=fd)
+    _warm()
+    fork = _fork_with_hooks()
+    wake_read, wake_write = os.pipe()
+    os.set_blocking(wake_write, False)
+    signal.set_wakeup_fd(wake_write)
+    signal.signal(signal.SIGCHLD, lambda *_: None)
+    _send(sock, {"ready": os.getpid()})
+    while True:
+        ready, _w, _x = select.select([sock, wake_read], [], [])
+        if wake_read in ready:
+            os.read(wake_read, 4096)
+            _reap(sock)
+        if sock in ready:
+            data, fds = _receive(sock)
+            if not data:
+                os._exit(0)  # the grader is gone
+            request = json.loads(data)
+            try:
+                pid = fork()
+            except OSError as exc:  # no process to be had: the grader execs this one
+                for passed in fds:
+                    os.close(passed)
+                _send(sock, {"error": f"fork: {exc}"})
+                continue
+            if pid == 0:
+                signal.set_wakeup_fd(-1)
+                signal.signal(signal.SIGCHLD, signal.SIG_DFL)
+                for own in (sock.detach(), wake_read, wake_write):
+                    os.close(own)
+                return _become_program(request, fds)
+            for passed in fds:
+                os.close(passed)
+            _send(sock, {"pid": pid})
+
+
+def _fork_with_hooks() -> Callable[[], int]:
+    """``os.fork`` wrapped in the fork hooks of every LTTng-UST copy loaded (rclpy's
+    wheels bundle it for ROS 2 tracing; its constructor starts two listener threads).
+    Without them a forked child dies of SIGSEGV at exit, when LTTng cancels threads
+    that only its parent has: the protocol of LTTng's own ``liblttng-ust-fork``."""
+    import ctypes
+
+    with open("/proc/self/maps") as maps:
+        paths = sorted({line.split()[-1] for line in maps
+                        if "/liblttng-ust-" in line and "tracepoint" not in line})
+    hooks = []
+    for path in paths:
+        with contextlib.suppress(OSError, AttributeError):
+            lib = ctypes.CDLL(path)
+            hooks.append((lib.ust_before_fork, lib.ust_after_fork_parent,
+                          lib.ust_after_fork_child, ctypes.create_string_buffer(1024)))
+
+    def fork() -> int:
+        for before, _parent, _child, saved in hooks:
+            before(saved)  # takes LTTng's locks and blocks signals until the after hook
+        pid = -1
+        try:
+            pid = os.fork()
+        finally:
+            for _before, parent, child, saved in reversed(hooks):
+                (child if pid == 0 else parent)(saved)
+        return pid
+
+    return fork
+
+
+def _reap(sock: socket.socket) -> None:
+    while True:
+        try:
+            pid, status, usage = os.wait4(-1, os.WNOHANG)
+        except ChildProcessError:
+            return
+        if pid == 0:
+            return
+        _send(sock, {"exited": pid, "status": status, "maxrss_kb": usage.ru_maxrss})
+
+
+def _receive(sock: socket.socket) -> tuple[bytes, list[int]]:
+    fds = array.array("i")
+    data, ancillary, _flags, _addr = sock.recvmsg(MAX_MESSAGE, socket.CMSG_SPACE(
+        8 * fds.itemsize))
+    for level, kind, payload in ancillary:
+        if level == socket.SOL_SOCKET and kind == socket.SCM_RIGHTS:
+            fds.frombytes(payload[:len(payload) - len(payload) % fds.itemsize])
+    return data, list(fds)
+
+
+def _become_program(request: dict, fds: list[int]) -> tuple[str, list[str]]:
+    """In the forked child: what the launcher does up to its exec, reporting a failure on
+    the status pipe as it does; then the pipe is closed, as an exec would close it."""
+    output, status = fds
+    os.setsid()
+    null = os.open(os.devnull, os.O_RDONLY)
+    os.dup2(null, 0)
+    for target in (1, 2):
+        os.dup2(output, target)
+    os.closerange(3, status)
+    os.closerange(status + 1, os.sysconf("SC_OPEN_MAX"))
+    stage = ["environment"]
+    try:
+        os.environ.clear()
+        os.environ.update(request["env"])
+        os.chdir(request["cwd"])
+        contain(request["spec"], stage)
+    except BaseException as exc:  # noqa: BLE001 - every failure before the program is ours
+        os.write(status, json.dumps({"stage": stage[0],
+                                     "error": f"{type(exc).__name__}: {exc}"}).encode())
+        os._exit(LAUNCH_FAILED)
+    os.close(status)
+    return request["script"], list(request["args"])
+
+
+def run_program(script: str, args: list[str]) -> None:
+    """Run ``script`` as ``python script args...`` runs it: as ``__main__``, its folder first
+    on the module path.  A KeyboardInterrupt ends it as CPython ends one (traceback, then
+    death by SIGINT once threads and exit handlers are done); any other exception prints
+    its traceback (the student's frames only) and exits with status 1."""
+    import types
+
+    sys.argv = [script, *args]
+    sys.path[0] = os.path.dirname(script)
+    main = types.ModuleType("__main__")
+    main.__file__ = script
+    main.__builtins__ = __builtins__
+    sys.modules["__main__"] = main
+    try:
+        code = compile(Path(script).read_bytes(), script, "exec")
+        exec(code, main.__dict__)  # noqa: S102 - running the student's program is the point
+    except SystemExit:
+        raise
+    except BaseException as exc:  # noqa: BLE001 - reported as the interpreter would
+        tb = exc.__traceback__.tb_next if exc.__traceback__ is not None else None
+        sys.excepthook(type(exc), exc.with_traceback(tb), tb)
+        if not isinstance(exc, KeyboardInterrupt):
+            sys.exit(1)
+        _exit_by_sigint()
+
+
+def _exit_by_sigint() -> None:
+    threading._shutdown()  # type: ignore[attr-defined]  # what Py_Finalize does first
+    import atexit
+
+    atexit._run_exitfuncs()
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(Exception):
+            stream.flush()
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+    os.kill(os.getpid(), signal.SIGINT)
+    os._exit(128 + signal.SIGINT)
+
+
+# -- the grader's side -----------------------------------------------------------------
+class ForkedProcess:
+    """A program the zygote forked, as much of :class:`subprocess.Popen` as
+    :class:`~autograder.sandbox.process.StudentProcess` uses."""
+
+    def __init__(self, zygote: Zygote, pid: int, stdout: int) -> None:
+        self._zygote = zygote
+        self.pid = pid
+        self.stdout = os.fdopen(stdout, "rb")
+        self.returncode: int | None = None
+
+    def poll(self) -> int | None:
+        if self.returncode is None:
+            status = self._zygote.status(self.pid, 0.0)
+            if status is not None:
+                self.returncode = status
+        return self.returncode
+
+    def wait(self, timeout: float | None = None) -> int:
+        if self.returncode is None:
+            status = self._zygote.status(self.pid, timeout)
+            if status is None:
+                raise subprocess.TimeoutExpired(str(self.pid), timeout or 0.0)
+            self.returncode = status
+        return self.returncode
+
+
+class ZygoteGone(Exception):
+    """The zygote could not be started, or is gone: launch the ordinary way."""
+
+
+class Zygote:
+    """The grader's end: starts the zygote, asks it for programs, hears how they ended.
+
+    One thread reads the zygote's messages; a program's exit status is known once the
+    zygote has reaped it.  If the zygote dies, programs it forked and not yet reported are
+    waited for by their pid until gone (their status is then unknown, read as killed)."""
+
+    def __init__(self, python: str, env: Mapping[str, str], cwd: str) -> None:
+        self.env = dict(env)
+        ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
+        try:
+            self.process = subprocess.Popen(
+                [python, "-s", "-m", "autograder.sandbox.zygote", str(theirs.fileno())],
+                env={**env, "OPENBLAS_NUM_THREADS": "1"}, cwd=cwd, stdin=subprocess.DEVNULL,
+                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True,
+                pass_fds=(theirs.fileno(),))
+        except OSError as exc:
+            ours.close()
+            raise ZygoteGone(str(exc)) from exc
+        finally:
+            theirs.close()
+        self._sock = ours
+        self._lock = threading.Condition()
+        self._replies: list[dict] = []
+        self._statuses: dict[int, int] = {}
+        self._alive = True
+        self.peak_kb = 0  # the largest peak resident size of a program it reaped
+        self._send_lock = threading.Lock()
+        self._reader = threading.Thread(target=self._read, daemon=True, name="zygote")
+        self._reader.start()
+        if self._reply(60.0).get("ready") is None:
+            self.close()
+            raise ZygoteGone("the zygote did not start")
+
+    def fits(self, env: Mapping[str, str]) -> bool:
+        """True if a program with ``env`` would start the same from here as by an exec."""
+        return self._alive and all(env.get(k) == self.env.get(k) for k in STARTUP_VARIABLES)
+
+    def spawn(self, spec: Mapping[str, object], script: str, args: Sequence[str],
+              env: Mapping[str, str], cwd: str, status_fd: int) -> ForkedProcess:
+        """Fork a program; its output goes to a new pipe (the returned process's stdout),
+        and the launcher's status report to ``status_fd`` (closed here)."""
+        read_end, write_end = os.pipe()
+        request = {"spec": dict(spec), "script": script, "args": list(args), "env": dict(env),
+                   "cwd": cwd}
+        try:
+            with self._send_lock:
+                try:
+                    self._sock.sendmsg([json.dumps(request).encode()], [(
+                        socket.SOL_SOCKET, socket.SCM_RIGHTS,
+                        array.array("i", [write_end, status_fd]))])
+                except OSError as exc:
+                    raise ZygoteGone(str(exc)) from exc
+                reply = self._reply(30.0)
+        except BaseException:
+            os.close(read_end)
+            raise
+        finally:
+            os.close(write_end)
+            os.close(status_fd)
+        if "pid" not in reply:
+            os.close(read_end)
+            raise ZygoteGone(str(reply.get("error", "no answer from the zygote")))
+        return ForkedProcess(self, int(reply["pid"]), read_end)
+
+    def status(self, pid: int, timeout: float | None) -> int | None:
+        """The exit status (as ``Popen.returncode``) of ``pid``, waiting up to ``timeout``."""
+        with self._lock:
+            self._lock.wait_for(lambda: pid in self._statuses or not self._alive, timeout)
+            if pid in self._statuses:
+                return self._statuses[pid]
+            if self._alive:
+                return None
+        return _orphan_status(pid, timeout)
+
+    def _reply(self, timeout: float) -> dict:
+        with self._lock:
+            if not self._lock.wait_for(lambda: self._replies or not self._alive, timeout):
+                return {}
+            return self._replies.pop(0) if self._replies else {}
+
+    def _read(self) -> None:
+        try:
+            while data := self._sock.recv(MAX_MESSAGE):
+                message = json.loads(data)
+                with self._lock:
+                    if "exited" in message:
+                        self._statuses[int(message["exited"])] = os.waitstatus_to_exitcode(
+                            int(message["status"]))
+                        self.peak_kb = max(self.peak_kb, int(message.get("maxrss_kb", 0)))
+                    else:
+                        self._replies.append(message)
+                    self._lock.notify_all()
+        except (OSError, ValueError):
+            pass
+        with self._lock:
+            self._alive = False
+            self._lock.notify_all()
+
+    def close(self) -> None:
+        with contextlib.suppress(OSError):
+            self._sock.shutdown(socket.SHUT_RDWR)
+        self._sock.close()
+        try:
+            self.process.wait(5.0)
+        except subprocess.TimeoutExpired:
+            self.process.kill()
+            self.process.wait()
+
+
+def _orphan_status(pid: int, timeout: float | None) -> int | None:
+    """A program whose zygote died: -SIGKILL once it is gone, None while it runs."""
+    import time
+
+    end = None if timeout is None else time.monotonic() + timeout
+    while True:
+        try:
+            with open(f"/proc/{pid}/stat", "rb") as fh:  # a zombie nobody reaps is gone too
+                if fh.read().rpartition(b")")[2].split()[0] == b"Z":
+                    return -signal.SIGKILL
+        except (OSError, IndexError):
+            return -signal.SIGKILL
+        if end is not None and time.monotonic() >= end:
+            return None
+        time.sleep(0.01)
+
+
+if __name__ == "__main__":
+    run_program(*serve(int(sys.argv[1])))

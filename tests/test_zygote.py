@@ -1,0 +1,142 @@
+"""The zygote: a student's program forked from a warm process runs as one exec'd would.
+
+Each case runs the same program both ways (``AUTOGRADER_ZYGOTE=0`` execs it through the
+launcher) and compares what a grader sees: exit status, output, and the program's view
+of itself (argv, working folder, environment, module path, ``__name__``).
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import signal
+import time
+from pathlib import Path
+
+import pytest
+
+from autograder.core.exercise import Limits
+from autograder.sandbox import process as process_module
+from autograder.sandbox.process import LaunchFailed, StudentProcess, student_process
+from autograder.sandbox.zygote import ForkedProcess
+
+ROOT = Path(__file__).resolve().parents[1]
+
+SELF = """\
+import os, sys
+print("argv", [os.path.basename(sys.argv[0]), *sys.argv[1:]])
+print("cwd", os.getcwd() == os.path.dirname(os.path.abspath(__file__)))
+print("path0", sys.path[0] == os.path.dirname(__file__), __name__)
+print("env", os.environ["ROS_DOMAIN_ID"], os.environ["HOME"] == os.getcwd())
+"""
+PROGRAMS = {
+    # A node left undestroyed at exit: a fork without LTTng's hooks died of SIGSEGV here.
+    "exit_code": SELF + """\
+import rclpy
+rclpy.init()
+node = rclpy.create_node("zygote_test")
+rclpy.shutdown()
+sys.exit(3)
+""",
+    "crash": SELF + """\
+def callback():
+    raise ValueError("boom")
+callback()
+""",
+    "interrupted": SELF + """\
+import time
+print("waiting", flush=True)
+time.sleep(60)
+""",
+}
+
+
+def _run(tmp_path: Path, name: str, forked: bool,
+         monkeypatch: pytest.MonkeyPatch) -> tuple[int | None, str, StudentProcess]:
+    monkeypatch.setenv("AUTOGRADER_ZYGOTE", "1" if forked else "0")
+    staged = tmp_path / ("forked" if forked else "execd") / name / "staged"
+    staged.mkdir(parents=True)
+    (staged / "prog.py").write_text(PROGRAMS[name])
+    program = student_process(staged / "prog.py", [], Limits(), domain=7, strict=False,
+                              course=ROOT)
+    program.start()
+    try:
+        if name == "interrupted":
+            end = time.monotonic() + 30
+            while "waiting" not in program.output_text() and time.monotonic() < end:
+                time.sleep(0.01)
+            program.signal(signal.SIGINT)
+        status = program.wait(30.0)
+    finally:
+        program.stop()
+    output = re.sub(r"/\S+/(prog\.py)", r"\1", program.output_text())
+    return status, output, program
+
+
+@pytest.mark.parametrize("name", sorted(PROGRAMS))
+def test_a_forked_program_ends_as_an_execd_one(name: str, tmp_path: Path,
+                                                monkeypatch: pytest.MonkeyPatch) -> None:
+    execd, execd_output, plain = _run(tmp_path, name, False, monkeypatch)
+    forked, forked_output, warm = _run(tmp_path, name, True, monkeypatch)
+    assert not isinstance(plain.popen, ForkedProcess)
+    assert isinstance(warm.popen, ForkedProcess)
+    assert execd == forked == {"exit_code": 3, "crash": 1, "interrupted": -2}[name]
+    assert forked_output == execd_output
+    assert "argv ['prog.py', '--ros-args']\ncwd True\npath0 True __main__\nenv 7 True\n" in (
+        forked_output)
+    if name != "exit_code":  # the traceback names the student's frames only
+        assert "zygote" not in forked_output and "prog.py" in forked_output
+
+
+def test_a_failure_before_the_program_is_the_launchers_either_way(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    class Unjoinable(process_module.Cgroup):  # a cgroup folder that is not there
+        def __init__(self, *args: object) -> None:
+            super().__init__(*args)  # type: ignore[arg-type]
+            self.paths = [tmp_path / "no-such-cgroup", *self.paths]
+
+    monkeypatch.setattr(process_module, "Cgroup", Unjoinable)
+    for forked in (False, True):
+        monkeypatch.setenv("AUTOGRADER_ZYGOTE", "1" if forked else "0")
+        staged = tmp_path / str(forked) / "staged"
+        staged.mkdir(parents=True)
+        (staged / "prog.py").write_text("print('never')\n")
+        program = student_process(staged / "prog.py", [], Limits(), domain=7, strict=False,
+                                  course=ROOT)
+        with pytest.raises(LaunchFailed) as failed:
+            program.start()
+        assert failed.value.stage == "cgroup"
+        assert "never" not in program.output_text()
+
+
+def test_a_dead_zygote_leaves_its_programs_killed_and_later_ones_execd(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(process_module, "_zygotes", {})
+    monkeypatch.setattr(process_module, "_zygotes_failed", False)
+    monkeypatch.setenv("AUTOGRADER_ZYGOTE", "1")
+    staged = tmp_path / "staged"
+    staged.mkdir()
+    (staged / "prog.py").write_text("import time\nprint('up', flush=True)\ntime.sleep(60)\n")
+
+    def start() -> StudentProcess:
+        program = student_process(staged / "prog.py", [], Limits(), domain=7, strict=False,
+                                  course=ROOT)
+        program.start()
+        return program
+
+    first = start()
+    try:
+        assert isinstance(first.popen, ForkedProcess)
+        (zygote,) = process_module._zygotes.values()
+        os.kill(zygote.process.pid, signal.SIGKILL)
+        zygote.process.wait()
+        assert first.wait(0.5) is None  # still running, though its zygote is gone
+        first.signal(signal.SIGKILL)
+        assert first.wait(10.0) == -signal.SIGKILL
+        second = start()
+        try:
+            assert not isinstance(second.popen, ForkedProcess)
+        finally:
+            second.stop()
+    finally:
+        first.stop()
