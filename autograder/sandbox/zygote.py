@@ -84,8 +84,9 @@ def serve(fd: int) -> tuple[str, list[str]]:
             _reap(sock)
         if sock in ready:
             data, fds = _receive(sock)
-            if not data:
-                os._exit(0)  # the grader is gone
+            if not data:  # the grader is done or gone: account for what has ended, and go
+                _reap(sock)
+                os._exit(0)
             request = json.loads(data)
             try:
                 pid = fork()
@@ -137,6 +138,8 @@ def _fork_with_hooks() -> Callable[[], int]:
 
 
 def _reap(sock: socket.socket) -> None:
+    """Wait for the programs that have ended (so their CPU time counts in the zygote's
+    children's, and through it in the grader's) and tell the grader how each ended."""
     while True:
         try:
             pid, status, usage = os.wait4(-1, os.WNOHANG)
@@ -144,7 +147,8 @@ def _reap(sock: socket.socket) -> None:
             return
         if pid == 0:
             return
-        _send(sock, {"exited": pid, "status": status, "maxrss_kb": usage.ru_maxrss})
+        with contextlib.suppress(OSError):
+            _send(sock, {"exited": pid, "status": status, "maxrss_kb": usage.ru_maxrss})
 
 
 def _receive(sock: socket.socket) -> tuple[bytes, list[int]]:
