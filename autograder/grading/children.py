@@ -116,9 +116,11 @@ def bytecode_env(env: dict[str, str]) -> dict[str, str]:
 
 @contextlib.contextmanager
 def started(prefix: Sequence[str], settings: RunSettings, targets: Sequence[str],
-            folder: Path, rootdir: Path, lock: DomainLock) -> Iterator[Child]:
+            folder: Path, rootdir: Path, lock: DomainLock, *,
+            zygote: bool = True) -> Iterator[Child]:
     """Start one child pytest over ``targets`` (test folders or modules) in ``folder``;
-    its lifeline closes when the block ends."""
+    its lifeline closes when the block ends.  ``zygote``: whether it forks students'
+    programs from a zygote (see :func:`autograder.sandbox.process.warm_start`)."""
     folder.mkdir(parents=True, exist_ok=True)
     report_path = folder / "report.json"
     key = secrets.token_bytes(32)
@@ -132,6 +134,8 @@ def started(prefix: Sequence[str], settings: RunSettings, targets: Sequence[str]
         "--autograder-settings", settings.to_json(), *targets,
     ]
     env = bytecode_env(dict(os.environ))
+    if not zygote:
+        env["AUTOGRADER_ZYGOTE"] = "0"
     log_path = folder / "pytest.log"
     try:
         with log_path.open("wb") as log:

@@ -163,7 +163,10 @@ def _run(exercise: Exercise, submission: Path | None, plan: _Plan,
          ) -> tuple[RunResult, RawReport]:
     """One grading in child pytests, one per reserved domain; the result and the merged
     raw report. Each child gets its :class:`~autograder.core.settings.RunSettings` as one
-    document (see :mod:`autograder.grading.children`)."""
+    document (see :mod:`autograder.grading.children`). A single child forks students'
+    programs from a zygote (it runs every module's, and a batch's CPU is what it saves);
+    children at once exec them (a zygote each would add about 20 MB each to the grading's
+    memory, for a start or two a child)."""
     targets = plan.targets(len(locks))
     settings = RunSettings(
         exercise=str(exercise.folder),
@@ -180,7 +183,7 @@ def _run(exercise: Exercise, submission: Path | None, plan: _Plan,
                 running.append(lifelines.enter_context(children.started(
                     run_prefix(isolation), dataclasses.replace(settings, count_only=count_only),
                     [str(t) for t in group], Path(tmp) / f"child-{index}", exercise.folder,
-                    lock)))
+                    lock, zygote=len(targets) == 1)))
             footprint = Footprint([child.process.pid for child in running])
             children.wait(running, exercise.time_limit, watchers, footprint)
         ended = [children.end(child) for child in running]
