@@ -3,6 +3,10 @@
 must never change a verdict).  Heavy: run it under `flock /tmp/agheavy.lock`.
 
     python benchmarks/bench_batch.py [--students 8] [--jobs 1,2,4,8,auto] [--exercise EX ...]
+
+For each ``--jobs`` it also prints the whole course: every exercise's batch one after
+another, as an instructor grades a class (``--students 100 --jobs auto``: the issue's
+class of 100).
 """
 
 from __future__ import annotations
@@ -54,13 +58,20 @@ def main() -> None:
     exercises = [find_exercise(e) for e in args.exercise] or list_exercises()
     columns = ["exercise", "jobs", "wall s", "s/student", "students/h", "all full"]
     print(" | ".join(columns), flush=True)
+    course: dict[str, list[dict[str, str]]] = {}
     with tempfile.TemporaryDirectory(prefix="bench-batch-") as tmp:
         for exercise in exercises:
             for jobs in args.jobs.split(","):
                 row = run(exercise, args.students, jobs, Path(tmp))
+                course.setdefault(jobs, []).append(row)
                 print(" | ".join(row[c] for c in columns), flush=True)
                 if row["said"]:
                     print(f"  {row['said']}", flush=True)
+    for jobs, rows in course.items():
+        wall = sum(float(r["wall s"]) for r in rows)
+        full = all(r["all full"] == "yes" for r in rows)
+        print(f"course at --jobs {jobs}: {len(rows)} exercises x {args.students} students in "
+              f"{wall / 60:.1f} min ({wall:.0f} s), every score full: {'yes' if full else 'NO'}")
 
 
 if __name__ == "__main__":

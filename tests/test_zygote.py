@@ -112,7 +112,7 @@ def test_a_failure_before_the_program_is_the_launchers_either_way(
 def test_a_dead_zygote_leaves_its_programs_killed_and_later_ones_execd(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(process_module, "_zygotes", {})
-    monkeypatch.setattr(process_module, "_zygotes_failed", False)
+    monkeypatch.setattr(process_module, "_zygotes_failed", set())
     monkeypatch.setenv("AUTOGRADER_ZYGOTE", "1")
     staged = tmp_path / "staged"
     staged.mkdir()
@@ -140,3 +140,34 @@ def test_a_dead_zygote_leaves_its_programs_killed_and_later_ones_execd(
             second.stop()
     finally:
         first.stop()
+
+
+def test_a_zygote_that_cannot_start_costs_only_its_own_launches(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """An interpreter that is not there (test_launch's case) fails its own zygote, and
+    the launcher reports it; the next program, run by the real interpreter, is forked."""
+    monkeypatch.setattr(process_module, "_zygotes", {})
+    monkeypatch.setattr(process_module, "_zygotes_failed", set())
+    monkeypatch.setenv("AUTOGRADER_ZYGOTE", "1")
+    for name, python in (("missing", "/nonexistent/python3"), ("real", None)):
+        if python is None:
+            monkeypatch.delenv("AUTOGRADER_STUDENT_PYTHON")
+        else:
+            monkeypatch.setenv("AUTOGRADER_STUDENT_PYTHON", python)
+        staged = tmp_path / name / "staged"
+        staged.mkdir(parents=True)
+        (staged / "prog.py").write_text("print('ran')\n")
+        program = student_process(staged / "prog.py", [], Limits(), domain=7, strict=False,
+                                  course=ROOT)
+        if python is not None:
+            with pytest.raises(LaunchFailed) as failed:
+                program.start()
+            assert failed.value.stage == f"exec {python}"
+            continue
+        program.start()
+        try:
+            assert isinstance(program.popen, ForkedProcess)
+            assert program.wait(30.0) == 0
+        finally:
+            program.stop()
+        assert program.output_text() == "ran\n"

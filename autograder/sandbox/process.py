@@ -132,22 +132,21 @@ def minimal_env(workdir: Path, extra: dict[str, str | None]) -> dict[str, str]:
 
 _zygotes: dict[tuple[str, ...], Any] = {}
 _zygotes_lock = threading.Lock()
-_zygotes_failed = False
+_zygotes_failed: set[tuple[str, ...]] = set()
 
 
 def warm_start(python: str, env: dict[str, str]) -> Any:
     """This process's zygote for programs run by ``python`` with ``env``
     (:mod:`autograder.sandbox.zygote`), started at the first launch; None where launches
-    are exec'd: ``AUTOGRADER_ZYGOTE=0``, a zygote that failed or died in this process,
-    or an environment Python would start differently."""
-    global _zygotes_failed
+    are exec'd: ``AUTOGRADER_ZYGOTE=0``, or a zygote for that interpreter and start-up
+    environment that could not start or died in this process."""
     from autograder.sandbox.zygote import STARTUP_VARIABLES, Zygote, ZygoteGone
 
     if os.environ.get("AUTOGRADER_ZYGOTE", "1") == "0":
         return None
     key = (python, *(f"{k}={env.get(k)}" for k in STARTUP_VARIABLES))
     with _zygotes_lock:
-        if _zygotes_failed:
+        if key in _zygotes_failed:
             return None
         zygote = _zygotes.get(key)
         if zygote is None:
@@ -156,10 +155,10 @@ def warm_start(python: str, env: dict[str, str]) -> Any:
             try:
                 zygote = _zygotes[key] = Zygote(python, env, "/")
             except ZygoteGone:
-                _zygotes_failed = True
+                _zygotes_failed.add(key)
                 return None
         if not zygote.fits(env):  # it died: from here on, exec
-            _zygotes_failed = True
+            _zygotes_failed.add(key)
             return None
         return zygote
 
