@@ -3,7 +3,11 @@
 The world advances in *clock ticks*.  A tick is a whole number of physics steps; after it
 the bridge publishes ``/clock`` (the tick's end time) and then the odometry and scans that
 fell due inside it, so a subscriber's clock has already reached a message's stamp.
-Commands received on ``/cmd_vel`` take effect at the start of the next tick.
+Commands on ``/cmd_vel`` are taken by the world's own thread at the start of each tick, not
+by an executor: every command the node's middleware has handed to the bridge by then drives
+that tick.  (An executor thread took them before; with eight gradings on two cores it was
+left without a CPU for up to 0.4 s of sim time while the world ticked on under the old
+command: a correct node's stop came late, and a batch changed a verdict.)
 
 What goes out is what a TurtleBot3 on Jazzy gives (REP 105 frames): ``/odom`` is wheel
 odometry in the ``odom`` frame, which starts at (0, 0, 0) where the robot starts, with
@@ -19,10 +23,11 @@ ticks per wall second, holding for a busy student process, the start-up hold) is
 by :class:`sim.pacing.Pacer`; the bridge only steps the world and publishes.
 ``effective_rtf`` reports the measured sim seconds per wall second of the last ticks.
 
-Physics runs in one thread and the executor (for /cmd_vel) in another; the world is
-only touched under the bridge's lock (the pacer's condition), and waiters are woken on it
-each tick.  Taps (:meth:`SimBridge.add_tap`, e.g. a :class:`sim.bag.BagRecorder`) see every
-message the bridge publishes or receives, with its simulation time.
+Physics runs in one thread and an executor (for the node's parameter services) in
+another; the world is only touched under the bridge's lock (the pacer's condition), and
+waiters are woken on it each tick.  Taps (:meth:`SimBridge.add_tap`, e.g. a
+:class:`sim.bag.BagRecorder`) see every message the bridge publishes or receives, with its
+simulation time.
 """
 
 from __future__ import annotations
@@ -39,6 +44,7 @@ from contextlib import AbstractContextManager
 from typing import Any
 
 from nav_msgs.msg import Odometry
+from rclpy.callback_groups import CallbackGroup
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
@@ -54,6 +60,20 @@ from sim.pacing import DEFAULT_CLOCK_HZ, DEFAULT_CPU_BUDGET, HoldOutcome, Pacer,
 from sim.physics import World
 from sim.recorder import Recording, Sample
 from sim.worldfile import CmdVelType, Fault
+
+
+class _TakenByTheWorld(CallbackGroup):
+    """A callback group no executor runs: its subscription is never in an executor's wait
+    set, and the world's thread takes its messages itself (:meth:`SimBridge.take_commands`)."""
+
+    def can_execute(self, entity: object) -> bool:
+        return False
+
+    def beginning_execution(self, entity: object) -> bool:
+        return False
+
+    def ending_execution(self, entity: object) -> None:
+        pass
 
 
 def _stamp(t: float) -> tuple[int, int]:
@@ -96,8 +116,9 @@ class SimBridge:
         self._clock_pub = self.node.create_publisher(Clock, "/clock", qos)
         self._odom_pub = self.node.create_publisher(Odometry, "/odom", qos)
         self._scan_pub = self.node.create_publisher(LaserScan, "/scan", qos)
-        self.node.create_subscription(MESSAGE_TYPES[self.cmd_vel_type], CMD_VEL_TOPIC,
-                                      self._on_cmd_vel, 10)
+        self._cmd_sub = self.node.create_subscription(
+            MESSAGE_TYPES[self.cmd_vel_type], CMD_VEL_TOPIC, self._on_cmd_vel, 10,
+            callback_group=_TakenByTheWorld())
         self._executor = SingleThreadedExecutor(context=context)
         self._executor.add_node(self.node)
         self._context = context
@@ -148,6 +169,7 @@ class SimBridge:
     def reset(self) -> None:
         """Back to time 0 and the start pose; no clock is published until the next tick."""
         with self._cond:
+            self.take_commands()  # those sent before the reset are dropped with it
             self.sim.reset()
             self._cmd = None
             self.pacer.forget_rate()
@@ -307,6 +329,17 @@ class SimBridge:
         self._cmd = (twist.linear.x, twist.angular.z)
         self._tap("/cmd_vel", msg, self.world.time)
 
+    def take_commands(self) -> int:
+        """Take every /cmd_vel message our middleware holds, oldest first, as each tick
+        does before it steps (no executor takes them); return how many there were.  The
+        last one drives the next tick."""
+        sub, count = self._cmd_sub, 0
+        with self._cond, sub.handle:
+            while (taken := sub.handle.take_message(sub.msg_type, sub.raw)) is not None:
+                self._on_cmd_vel(taken[0])
+                count += 1
+        return count
+
     def _spin(self) -> None:
         while self._spinning and self._context.ok():
             self._executor.spin_once(timeout_sec=0.05)
@@ -323,6 +356,7 @@ class SimBridge:
 
     def _tick(self, steps: int) -> None:
         """Advance ``steps`` physics steps and publish clock, odometry and scans."""
+        self.take_commands()
         cmd, self._cmd = self._cmd, None
         if cmd is not None:
             self.sim.set_command(*cmd)

@@ -150,6 +150,28 @@ def test_pause_step_reset(graph: tuple[SimBridge, Probe]) -> None:
     assert bridge.effective_rtf > 0.5
 
 
+def test_the_world_takes_commands_at_each_tick(graph: tuple[SimBridge, Probe]) -> None:
+    """No executor takes /cmd_vel: the world's thread takes every command that has arrived
+    before it steps, and the last of them drives that tick (while paused nothing takes
+    them, so they wait in the middleware)."""
+    bridge, probe = graph
+    bridge.pause()
+    try:
+        taken: list[int] = []
+        for speed in (0.1, 0.2):
+            msg = Twist()
+            msg.linear.x = speed
+            probe.cmd.publish(msg)
+        assert bridge.wait_for(lambda: taken.append(bridge.take_commands()) or sum(taken) == 2,
+                               sim_timeout=1.0, wall_timeout=WALL)
+        assert bridge.take_commands() == 0
+        bridge.step(1)
+        assert bridge.recording.commands[-1].linear == 0.2
+    finally:
+        probe.cmd.publish(Twist())
+        bridge.resume()
+
+
 def test_waits_are_told_to_on_wait(graph: tuple[SimBridge, Probe]) -> None:
     """Each wait on sim time tells the grader's timing how long it blocked and how much
     of that the world was held (none here: no process is watched)."""
