@@ -58,6 +58,7 @@ from sim.faults import Scan
 from sim.msgdefs import type_name
 from sim.pacing import DEFAULT_CLOCK_HZ, DEFAULT_CPU_BUDGET, HoldOutcome, Pacer, PacingPolicy
 from sim.physics import World
+from sim.procstate import Receiving
 from sim.recorder import Recording, Sample
 from sim.worldfile import CmdVelType, Fault
 
@@ -98,9 +99,12 @@ class SimBridge:
         self.world = world
         self.recheck = 0.01
         # Before the node: bad settings (a negative RTF, no clock rate) raise ValueError here.
+        # A hold for the student's node ends once our middleware has taken in what it sent.
+        self._receiving = Receiving()
         self.pacer = Pacer(world.dt, real_time_factor, PacingPolicy(
             clock_hz=max_clock_hz, cpu_budget=cpu_budget, hold_cap=quiescence_cap,
-            settle=settle, poll_interval=poll_interval, max_tick=max_tick))
+            settle=settle, poll_interval=poll_interval, max_tick=max_tick),
+            receiving=self._receiving)
         self._cond = self.pacer.condition
         self._cmd: tuple[float, float] | None = None
         # (time.time_ns() just before a tick's /clock went out, that tick's sim time)
@@ -143,6 +147,7 @@ class SimBridge:
         for thread in self._threads:
             thread.join()
         self._threads = []
+        self._receiving.close()
         self._executor.remove_node(self.node)
         self._executor.shutdown(timeout_sec=1.0)
         self.node.destroy_node()

@@ -50,6 +50,14 @@ processes, in milliseconds.
   ``/clock`` subscription, or hung before making its node) thus costs one
   ``hear_timeout``, not one per tick.  Ticks held this way are counted
   (:attr:`Pacer.late_deliveries`: those the pacing would otherwise have let go early).
+* **Taken in.**  Then the world's own middleware must have taken in what the processes
+  sent: a tick goes only once the world's receive threads are idle and the kernel holds no
+  received packets (:class:`sim.procstate.Receiving`), for up to ``receive_timeout``
+  (0.5 s).  A node idle after publishing its command has sent it, but on a loaded machine
+  the grader's own receive thread may wait for a CPU meanwhile: eight error_handling
+  gradings on two cores took 1.5% of a correct node's commands one to three ticks late,
+  and one of 100 such gradings lost a test to it.  Holds that waited for this are counted
+  (:attr:`Pacer.receipts_awaited`).
 * **Held.**  Inside :meth:`Pacer.held` (a student's program starting) no tick goes;
   afterwards the schedule starts afresh from that moment.
 
@@ -132,6 +140,9 @@ class PacingPolicy:
     pace at a sixth of the CPU."""
     max_tick: float = 2.0
     """Longest tick at RTF 0, in sim seconds."""
+    receive_timeout: float = 0.5
+    """Longest wait, once the watched processes are done, for the world's middleware to
+    take in what they sent."""
 
     def __post_init__(self) -> None:
         if self.clock_hz <= 0:
@@ -161,6 +172,7 @@ class Pacer:
     def __init__(self, dt: float, real_time_factor: float = 1.0,
                  policy: PacingPolicy | None = None, *, clock: Clock | None = None,
                  read_process: ProcessReader | None = None,
+                 receiving: Callable[[], bool] | None = None,
                  condition: threading.Condition | None = None) -> None:
         if real_time_factor < 0:
             raise ValueError("real_time_factor must be >= 0")
@@ -171,6 +183,8 @@ class Pacer:
         # Ours (files kept open, closed with the pacer) unless a test passes its own.
         self._own_reader = ProcessStateReader() if read_process is None else None
         self._read: ProcessReader = read_process or self._own_reader  # type: ignore[assignment]
+        # True while the world's middleware still takes messages in (None: never waited for).
+        self._receiving = receiving
         self._rtf = real_time_factor
         self._adaptive_tick = 1.0 / self.policy.clock_hz
         self._running = True
@@ -188,6 +202,8 @@ class Pacer:
         self.late_deliveries = 0
         # Holds in which a process used more than cpu_budget, drawing on its reserve.
         self.bursts = 0
+        # Holds that, the processes done, waited for the world to take in what they sent.
+        self.receipts_awaited = 0
         self._reserve: dict[int, float] = {}  # CPU seconds each watched process has banked
         self._before: dict[int, int] = {}  # CPU ns of each watched process before a tick
         self._heard: set[int] = set()  # those seen to hear the last tick during its hold
@@ -376,7 +392,8 @@ class Pacer:
         CPU since the tick and whatever it has in reserve (it is busy, not slow); one that
         is runnable but gets no CPU (a busy machine) holds the world back, up to
         ``hold_cap`` of wall time; one that is idle but has not heard the tick is waited for
-        up to ``hear_timeout``.
+        up to ``hear_timeout``.  Then, up to ``receive_timeout``, the world's middleware
+        must have taken in what they sent.
         """
         with self.condition:
             pids = tuple(self._pids)
@@ -401,6 +418,8 @@ class Pacer:
         deafness = published + policy.hear_timeout
         outcome: HoldOutcome = "cap"
         late = False
+        receipt_cap: float | None = None  # set once the processes are done
+        awaited = False
         states: dict[int, ProcessState] = {}
         while (now := clock.monotonic()) < cap:
             states = {pid: self._read(pid) for pid in pids}
@@ -414,10 +433,17 @@ class Pacer:
                 outcome = "unheard"
                 break
             if not working and not waiting:
-                outcome = "budget" if any(s.busy for s in states.values()) else "idle"
-                break
+                if receipt_cap is None:
+                    receipt_cap = now + policy.receive_timeout
+                if self._receiving is None or now >= receipt_cap or not self._receiving():
+                    outcome = "budget" if any(s.busy for s in states.values()) else "idle"
+                    break
+                awaited = True
+                clock.sleep(policy.poll_interval)
+                continue
             late = late or not working
             clock.sleep(policy.poll_interval)
+        self.receipts_awaited += awaited
         burst = False
         with self.condition:
             self._heard = {pid for pid, yes in heard.items() if yes}

@@ -171,6 +171,104 @@ def _close(pair: tuple[int, int]) -> None:
         os.close(fd)
 
 
+RECEIVE_THREADS = (b"dds.udp.", b"dds.shm.")
+"""How Fast DDS (Jazzy's default middleware) names the threads that receive its
+transports' datagrams (``dds.udp.<port>``, ``dds.shm.<port>``)."""
+NOT_RECEIVING = (b"dds.shm.wdog",)
+"""Threads with those names that receive nothing (the shared-memory watchdog)."""
+SOFTNET_STAT = "/proc/net/softnet_stat"
+
+
+class Receiving:
+    """Whether this process's middleware still has messages to take in: one of its
+    receive threads is running or runnable, or the kernel holds received packets that no
+    socket has been handed yet.
+
+    A node that is idle has sent what it sent: each datagram is then in the kernel's
+    backlog (a busy machine leaves that work to ``ksoftirqd``), or queued on a socket,
+    which makes the thread reading that socket runnable, or already in the reader's
+    history, where the world takes it (:meth:`sim.bridge.SimBridge.take_commands`).  The
+    backlog is the machine's, not this process's (``/proc/net/softnet_stat``, the sum of
+    every CPU's queue, from Linux 5.10): reading it as ours only holds longer, never
+    shorter.
+
+    Each thread's ``stat`` is kept open (a thread's name is read once); safe to call from
+    any thread; :meth:`close` closes the files.
+    """
+
+    def __init__(self, names: tuple[bytes, ...] = RECEIVE_THREADS,
+                 softnet: str = SOFTNET_STAT) -> None:
+        self._names = names
+        self._softnet = softnet
+        self._threads: dict[str, int | None] = {}  # tid -> its stat file, None if not one
+        self._lock = threading.Lock()
+        self._closed = False
+
+    def __call__(self) -> bool:
+        with self._lock:
+            if self._closed:
+                return False
+            return self._threads_busy() or backlog(self._softnet) > 0
+
+    def _threads_busy(self) -> bool:
+        try:
+            tids = os.listdir("/proc/self/task")
+        except OSError:
+            return False
+        for tid in self._threads.keys() - set(tids):
+            fd = self._threads.pop(tid)
+            if fd is not None:
+                os.close(fd)
+        busy = False
+        for tid in tids:
+            if tid not in self._threads:
+                self._threads[tid] = self._open_if_receiving(tid)
+            fd = self._threads[tid]
+            if fd is None or busy:
+                continue
+            try:
+                busy = _thread_running(os.pread(fd, 4096, 0))
+            except OSError:  # ended, or its number reused: look again next time
+                os.close(self._threads.pop(tid))
+            except (ValueError, IndexError):
+                continue
+        return busy
+
+    def _open_if_receiving(self, tid: str) -> int | None:
+        try:
+            with open(f"/proc/self/task/{tid}/comm", "rb") as fh:
+                name = fh.read().strip()
+            if not name.startswith(self._names) or name.startswith(NOT_RECEIVING):
+                return None
+            return os.open(f"/proc/self/task/{tid}/stat", os.O_RDONLY | os.O_CLOEXEC)
+        except OSError:
+            return None
+
+    def close(self) -> None:
+        with self._lock:
+            self._closed = True
+            for fd in self._threads.values():
+                if fd is not None:
+                    os.close(fd)
+            self._threads.clear()
+
+
+def backlog(path: str = SOFTNET_STAT) -> int:
+    """Packets the kernel has received and not yet handed to a socket, over every CPU
+    (0 where the kernel does not say: before Linux 5.10, or no ``/proc/net``)."""
+    try:
+        with open(path, "rb") as fh:
+            rows = fh.read().split(b"\n")
+    except OSError:
+        return 0
+    total = 0
+    for row in rows:
+        columns = row.split()
+        if len(columns) >= 13:  # ..., flow_limit_count, backlog length, CPU number, ...
+            total += int(columns[11], 16)
+    return total
+
+
 def process_busy(pid: int) -> bool:
     """True if any thread of ``pid`` is running or runnable; False if idle or gone."""
     return read_process_state(pid).busy

@@ -373,6 +373,34 @@ def test_a_tick_heard_after_the_timeout_still_counts_as_heard() -> None:
     assert run.pacer.counts == {"unheard": 1, "idle": 2} and run.pacer.late_deliveries == 2
 
 
+def test_a_tick_waits_for_the_world_to_take_in_what_was_sent() -> None:
+    """A node idle after publishing has sent its command, but the world's own receive
+    thread may still wait for a CPU: the next tick goes once the world has taken it in,
+    and only then, for up to receive_timeout."""
+    clock = FakeClock()
+    process = FakeProcess(clock, idle_at=clock.now, reaction=0.005)
+
+    def receiving() -> bool:  # each tick's message is taken in 0.03 s after it went out
+        return clock.now < clock.ticks[-1] + 0.03
+
+    run = Run(Pacer(DT, 1.0, clock=clock, read_process=process, receiving=receiving),
+              clock)
+    run.pacer.watch(4242)
+    run.ticks_for(3)
+    assert run.pacer.counts == {"idle": 3} and run.pacer.receipts_awaited == 3
+    assert run.pacer.longest_hold == pytest.approx(0.03, abs=0.001)
+    assert run.gaps() == pytest.approx([0.05] * 2, abs=1e-9)  # within the period: no cost
+    never = Run(Pacer(DT, 1.0, PacingPolicy(receive_timeout=0.2), clock=clock,
+                      read_process=process, receiving=lambda: True), clock)
+    never.pacer.watch(4242)
+    never.ticks_for(3)  # receiving never ends: each hold is cut at receive_timeout
+    assert never.pacer.counts == {"idle": 3} and never.pacer.receipts_awaited == 3
+    assert never.gaps() == pytest.approx([0.206] * 2, abs=0.002)  # reaction, then 0.2 s
+    free = Run(Pacer(DT, 1.0, clock=clock, receiving=lambda: True), clock).ticks_for(3)
+    assert free.pacer.counts == {"free": 3} and free.pacer.receipts_awaited == 0
+    assert free.gaps() == pytest.approx([0.05] * 2, abs=1e-9)  # nothing watched: no hold
+
+
 def test_a_process_being_stopped_is_not_waited_for_to_hear() -> None:
     """Once the grader stops a node, it stops hearing ticks: no hear_timeout for that."""
     clock = FakeClock()

@@ -11,7 +11,14 @@ from collections.abc import Iterator
 import pytest
 
 from sim.pacing import DEFAULT_CPU_BUDGET
-from sim.procstate import IDLE, ProcessStateReader, process_busy, read_process_state
+from sim.procstate import (
+    IDLE,
+    ProcessStateReader,
+    Receiving,
+    backlog,
+    process_busy,
+    read_process_state,
+)
 
 WALL = 20.0
 
@@ -163,3 +170,66 @@ def test_the_reader_keeps_few_files_and_none_once_closed(spinner: subprocess.Pop
     reader.close()
     assert _open_fds() == fds
     assert reader(spinner.pid).busy and _open_fds() == fds  # closed: read the slow way
+
+
+def _name_thread(tid: int, name: str) -> None:
+    with open(f"/proc/self/task/{tid}/comm", "w") as fh:  # a process may rename its own
+        fh.write(name)
+
+
+def test_receiving_follows_the_receive_threads_by_name(tmp_path) -> None:  # noqa: ANN001
+    """A thread named as Fast DDS names its receive threads counts while it runs; it and
+    a thread of another name do not while they wait."""
+    import threading
+
+    quiet = tmp_path / "softnet_stat"
+    quiet.write_text("00000001 " * 11 + "00000000 00000000 00000000 00000000\n")  # no backlog
+    stop, go = threading.Event(), threading.Event()
+    tids: list[int] = []
+
+    def receiver() -> None:
+        tids.append(threading.get_native_id())
+        go.wait()
+        while not stop.is_set():  # "receiving": runs until told to stop
+            pass
+
+    def other() -> None:
+        tids.append(threading.get_native_id())
+        stop.wait()
+
+    threads = [threading.Thread(target=receiver), threading.Thread(target=other)]
+    for thread in threads:
+        thread.start()
+    receiving = Receiving(softnet=str(quiet))
+    try:
+        assert _poll(lambda: len(tids) == 2)
+        _name_thread(tids[0], "dds.udp.7411")
+        _name_thread(tids[1], "dds.shm.wdog")
+        assert _poll(lambda: not receiving())  # named, but waiting
+        go.set()
+        assert _poll(receiving)
+        stop.set()
+        threads[0].join()
+        assert _poll(lambda: not receiving())
+    finally:
+        go.set()
+        stop.set()
+        for thread in threads:
+            thread.join()
+        receiving.close()
+    assert not receiving()  # closed: nothing to wait for
+
+
+def test_receiving_counts_packets_the_kernel_still_holds(tmp_path) -> None:  # noqa: ANN001
+    """softnet_stat's backlog column (Linux 5.10+), summed over CPUs; older kernels'
+    shorter rows say nothing, so they count as none."""
+    stat = tmp_path / "softnet_stat"
+    row = "00dca0bc 00000000 00000004 " + "00000000 " * 8 + "{backlog:08x} {cpu:08x}"
+    stat.write_text("\n".join([row.format(backlog=0, cpu=0) + " 00000000 00000000",
+                               row.format(backlog=3, cpu=1) + " 00000003 00000000"]) + "\n")
+    assert backlog(str(stat)) == 3
+    assert Receiving(names=(), softnet=str(stat))()
+    stat.write_text("00dca0bc 00000000 00000004" + " 00000000" * 8 + "\n")  # Linux 5.4
+    assert backlog(str(stat)) == 0
+    assert backlog(str(tmp_path / "missing")) == 0
+    assert backlog() >= 0  # this machine's

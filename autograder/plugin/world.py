@@ -111,7 +111,8 @@ def world(request: pytest.FixtureRequest, exercise: Exercise,
                 **bridge.pacing, "longest_hold": round(bridge.longest_hold, 3),
                 "held_seconds": round(bridge.pacer.held_seconds, 3),
                 "late_deliveries": bridge.pacer.late_deliveries,
-                "bursts": bridge.pacer.bursts}
+                "bursts": bridge.pacer.bursts,
+                "receipts_awaited": bridge.pacer.receipts_awaited}
 
 
 def _timing(request: pytest.FixtureRequest) -> Timing:
