@@ -2,6 +2,10 @@
 --jobs, in wall seconds and students per hour, and whether every score was full (the batch
 must never change a verdict).  Heavy: run it under `flock /tmp/agheavy.lock`.
 
+"late cmds" sums the results' ``pacing.late_commands`` over the batch: commands a world
+took in a later tick than the one they were sent in (it must stay 0), with the most sim
+seconds one was late.  Students whose score was not full are named with their lost tests.
+
     python benchmarks/bench_batch.py [--students 8] [--jobs 1,2,4,8,auto] [--exercise EX ...]
 
 For each ``--jobs`` it also prints the whole course: every exercise's batch one after
@@ -13,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import json
 import re
 import subprocess
 import sys
@@ -42,11 +47,29 @@ def run(exercise: Exercise, copies: int, jobs: str, workdir: Path) -> dict[str, 
         rows = list(csv.DictReader(fh)) if proc.returncode == 0 else []
     full = len(rows) == copies and all(r["score"] == r["max_score"] for r in rows)
     chosen = CHOSEN.search(proc.stderr)
+    late, latest, lost = _results(folder / "out")
     return {"exercise": exercise.id, "jobs": jobs + (f" ({chosen[1]})" if chosen else ""),
             "wall s": f"{wall:.1f}", "s/student": f"{wall / copies:.1f}",
             "students/h": f"{3600 * copies / wall:.0f}",
             "all full": "yes" if full else f"NO ({proc.returncode})",
-            "said": chosen[0] if chosen else ""}
+            "late cmds": f"{late} ({latest:.2f} s)" if late else "0",
+            "said": chosen[0] if chosen else "", "lost": "; ".join(lost)}
+
+
+def _results(out: Path) -> tuple[int, float, list[str]]:
+    """From each student's results file: late commands summed, the latest, and who lost
+    which tests."""
+    late, latest, lost = 0, 0.0, []
+    for path in sorted(out.glob("*/results.json")):
+        data = json.loads(path.read_text(encoding="utf-8"))
+        for module in data.get("pacing", {}).values():
+            late += module.get("late_commands", 0)
+            latest = max(latest, module.get("latest_command", 0.0))
+        missed = [t["name"] for t in data.get("tests", [])
+                  if t.get("score", 0) < t.get("max_score", 0)]
+        if missed or data.get("grader_error"):
+            lost.append(f"{path.parent.name}: {', '.join(missed) or data['grader_error']}")
+    return late, latest, lost
 
 
 def main() -> None:
@@ -56,7 +79,8 @@ def main() -> None:
     parser.add_argument("--exercise", action="append", default=[])
     args = parser.parse_args()
     exercises = [find_exercise(e) for e in args.exercise] or list_exercises()
-    columns = ["exercise", "jobs", "wall s", "s/student", "students/h", "all full"]
+    columns = ["exercise", "jobs", "wall s", "s/student", "students/h", "all full",
+               "late cmds"]
     print(" | ".join(columns), flush=True)
     course: dict[str, list[dict[str, str]]] = {}
     with tempfile.TemporaryDirectory(prefix="bench-batch-") as tmp:
@@ -67,6 +91,8 @@ def main() -> None:
                 print(" | ".join(row[c] for c in columns), flush=True)
                 if row["said"]:
                     print(f"  {row['said']}", flush=True)
+                if row["lost"]:
+                    print(f"  lost: {row['lost']}", flush=True)
     for jobs, rows in course.items():
         wall = sum(float(r["wall s"]) for r in rows)
         full = all(r["all full"] == "yes" for r in rows)

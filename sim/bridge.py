@@ -107,6 +107,10 @@ class SimBridge:
             receiving=self._receiving)
         self._cond = self.pacer.condition
         self._cmd: tuple[float, float] | None = None
+        # Commands taken in a later tick than the one they were sent in, and the most sim
+        # seconds one was late: the world's own check that no tick overtook a command.
+        self.late_commands = 0
+        self.latest_command = 0.0
         # (time.time_ns() just before a tick's /clock went out, that tick's sim time)
         self._clock_log: list[tuple[int, float]] = []
         self._threads: list[threading.Thread] = []
@@ -341,9 +345,22 @@ class SimBridge:
         sub, count = self._cmd_sub, 0
         with self._cond, sub.handle:
             while (taken := sub.handle.take_message(sub.msg_type, sub.raw)) is not None:
+                self._note_lateness(taken[1])
                 self._on_cmd_vel(taken[0])
                 count += 1
         return count
+
+    def _note_lateness(self, info: object) -> None:
+        """Count a command sent before the tick now due: ticks went on without it.  When it
+        was sent is its DDS source timestamp, read as the sim time of the last /clock out
+        by then (the clock is the machine's, the sender's and ours)."""
+        source = info.get("source_timestamp") if isinstance(info, dict) else None
+        if not source or not self._clock_log:
+            return
+        late = self.world.time - self.sim_time_at(source)
+        if late > 1e-9:
+            self.late_commands += 1
+            self.latest_command = max(self.latest_command, late)
 
     def _spin(self) -> None:
         while self._spinning and self._context.ok():

@@ -112,7 +112,9 @@ def world(request: pytest.FixtureRequest, exercise: Exercise,
                 "held_seconds": round(bridge.pacer.held_seconds, 3),
                 "late_deliveries": bridge.pacer.late_deliveries,
                 "bursts": bridge.pacer.bursts,
-                "receipts_awaited": bridge.pacer.receipts_awaited}
+                "receipts_awaited": bridge.pacer.receipts_awaited,
+                "late_commands": bridge.late_commands,
+                "latest_command": round(bridge.latest_command, 3)}
 
 
 def _timing(request: pytest.FixtureRequest) -> Timing:
