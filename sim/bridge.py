@@ -91,7 +91,7 @@ class SimBridge:
     def __init__(self, world: World, context: Context, *, real_time_factor: float = 1.0,
                  max_clock_hz: float = DEFAULT_CLOCK_HZ, node_name: str = "sim_world",
                  quiescence_cap: float = 2.0, cpu_budget: float = DEFAULT_CPU_BUDGET,
-                 poll_interval: float = 0.001,
+                 poll_interval: float = 0.0005,
                  settle: float = 0.001, max_tick: float = 2.0,
                  cmd_vel_type: CmdVelType | None = None) -> None:
         self.sim = Simulation(world)

@@ -76,7 +76,7 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from typing import Literal, Protocol
 
-from sim.procstate import ProcessReader, ProcessState, ProcessStateReader
+from sim.procstate import ProcessReader, ProcessState, read_process_state
 
 DEFAULT_CLOCK_HZ = 20.0
 """Most ``/clock`` messages per wall second; see the module's docstring for why 20."""
@@ -133,11 +133,12 @@ class PacingPolicy:
     """Longest wait, from the tick's publication, for a watched process to hear it."""
     cpu_reserve: float = 2.0
     """Most CPU seconds a watched process may bank, beyond ``cpu_budget``, for a burst."""
-    poll_interval: float = 0.001
-    """Pause between two readings of the watched processes while holding a tick.  Each
-    reading took 0.56 ms when the files were opened each time, so 0.5 ms of pause made a
-    reading about every millisecond; with the files kept open (90 us) 1 ms keeps that
-    pace at a sixth of the CPU."""
+    poll_interval: float = 0.0005
+    """Pause between two readings of the watched processes while holding a tick (a
+    reading of a 16-thread rclpy process takes about 0.56 ms more).  Reading through
+    files kept open (90 us) every 1 ms, shipped for two stops, let Jazzy's
+    MultiThreadedExecutor spin far longer in a hold, unexplained: a correct node then
+    lost points alone (README, "Pacing")."""
     max_tick: float = 2.0
     """Longest tick at RTF 0, in sim seconds."""
     receive_timeout: float = 0.5
@@ -171,7 +172,7 @@ class Pacer:
 
     def __init__(self, dt: float, real_time_factor: float = 1.0,
                  policy: PacingPolicy | None = None, *, clock: Clock | None = None,
-                 read_process: ProcessReader | None = None,
+                 read_process: ProcessReader = read_process_state,
                  receiving: Callable[[], bool] | None = None,
                  condition: threading.Condition | None = None) -> None:
         if real_time_factor < 0:
@@ -180,9 +181,7 @@ class Pacer:
         self.policy = policy or PacingPolicy()
         self.condition = condition or threading.Condition(threading.RLock())
         self._clock: Clock = clock or SystemClock()
-        # Ours (files kept open, closed with the pacer) unless a test passes its own.
-        self._own_reader = ProcessStateReader() if read_process is None else None
-        self._read: ProcessReader = read_process or self._own_reader  # type: ignore[assignment]
+        self._read = read_process
         # True while the world's middleware still takes messages in (None: never waited for).
         self._receiving = receiving
         self._rtf = real_time_factor
@@ -238,17 +237,10 @@ class Pacer:
                 self.resume()
 
     def stop(self) -> None:
-        """Make :meth:`next_tick` return None, now if it is waiting; close the files kept
-        open for reading the watched processes."""
+        """Make :meth:`next_tick` return None, now if it is waiting."""
         with self.condition:
             self._running = False
             self.condition.notify_all()
-        if self._own_reader is not None:
-            self._own_reader.close()
-
-    def _forget(self, pid: int) -> None:
-        if self._own_reader is not None:
-            self._own_reader.forget(pid)
 
     # -- settings -------------------------------------------------------------------
     @property
@@ -267,8 +259,6 @@ class Pacer:
         """Also hold ticks while process ``pid`` has work (None: watch nothing)."""
         with self.condition:
             if pid is None:
-                for gone in self._pids:
-                    self._forget(gone)
                 self._pids.clear()
                 self._listening.clear()
                 self._closing.clear()
@@ -282,7 +272,6 @@ class Pacer:
 
     def unwatch(self, pid: int) -> None:
         with self.condition:
-            self._forget(pid)
             self._pids.discard(pid)
             self._listening.discard(pid)
             self._closing.discard(pid)

@@ -13,7 +13,6 @@ import pytest
 from sim.pacing import DEFAULT_CPU_BUDGET
 from sim.procstate import (
     IDLE,
-    ProcessStateReader,
     Receiving,
     backlog,
     process_busy,
@@ -126,50 +125,6 @@ for stop, _ in stops:
 
 def _open_fds() -> int:
     return len(os.listdir("/proc/self/fd"))
-
-
-def test_the_reader_keeping_files_open_reads_what_opening_them_reads() -> None:
-    """ProcessStateReader (the pacing's) follows threads that start and end, and closes
-    what it kept for a process once it is gone or forgotten."""
-    proc = subprocess.Popen(THREADS, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
-    assert proc.stdin is not None and proc.stdout is not None
-    reader = ProcessStateReader()
-    fds = _open_fds()
-
-    def command(line: str) -> int:
-        proc.stdin.write(line + "\n")
-        proc.stdin.flush()
-        return int(proc.stdout.readline())
-
-    try:
-        assert _poll(lambda: not reader(proc.pid).busy)
-        for line, threads in (("+", 2), ("+", 3), ("-", 2), ("-", 1), ("+", 2)):
-            assert command(line) == threads
-            assert _poll(lambda n=threads: len(os.listdir(f"/proc/{proc.pid}/task")) == n)
-            # Once idle, the two readings agree (nothing moves between them).
-            assert _poll(lambda: reader(proc.pid) == read_process_state(proc.pid))
-            assert reader(proc.pid).exists and reader(proc.pid).cpu_ns > 0
-            assert _open_fds() == fds + 2 * threads  # two files a thread, the ended closed
-        reader.forget(proc.pid)
-        assert _open_fds() == fds
-        assert reader(proc.pid).exists
-    finally:
-        proc.kill()
-        proc.wait()
-    assert reader(proc.pid) == IDLE
-    assert _open_fds() == fds
-
-
-def test_the_reader_keeps_few_files_and_none_once_closed(spinner: subprocess.Popen[str]) -> None:
-    reader = ProcessStateReader(max_threads=0)  # every thread read the slow way
-    fds = _open_fds()
-    state = reader(spinner.pid)
-    assert state.busy and state.cpu_ns > 0 and _open_fds() == fds
-    reader = ProcessStateReader()
-    assert reader(spinner.pid).busy and _open_fds() == fds + 2
-    reader.close()
-    assert _open_fds() == fds
-    assert reader(spinner.pid).busy and _open_fds() == fds  # closed: read the slow way
 
 
 def _name_thread(tid: int, name: str) -> None:
