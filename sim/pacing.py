@@ -54,9 +54,10 @@ processes, in milliseconds.
   sent: a tick goes only once the world's receive threads are idle and the kernel holds no
   received packets (:class:`sim.procstate.Receiving`), for up to ``receive_timeout``
   (0.5 s).  A node idle after publishing its command has sent it, but on a loaded machine
-  the grader's own receive thread may wait for a CPU meanwhile: eight error_handling
-  gradings on two cores took 1.5% of a correct node's commands one to three ticks late,
-  and one of 100 such gradings lost a test to it.  Holds that waited for this are counted
+  the grader's own receive thread may wait for a CPU meanwhile: with eight error_handling
+  gradings on two cores, 1.5% of a correct node's commands were taken one to three ticks
+  late without this wait (4.5% when an executor thread took them, and one of 100 such
+  gradings lost a test).  Holds that waited for this are counted
   (:attr:`Pacer.receipts_awaited`).
 * **Held.**  Inside :meth:`Pacer.held` (a student's program starting) no tick goes;
   afterwards the schedule starts afresh from that moment.
