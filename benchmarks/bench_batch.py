@@ -3,8 +3,9 @@
 must never change a verdict).  Heavy: run it under `flock /tmp/agheavy.lock`.
 
 "late cmds" sums the results' ``pacing.late_commands`` over the batch: commands a world
-took in a later tick than the one they were sent in (it must stay 0), with the most sim
-seconds one was late.  Students whose score was not full are named with their lost tests.
+took in a later tick than the one they were sent in (ticks that went on without them; the
+tests allow one tick), with the most sim seconds one was late.  Students whose score was
+not full are named with their lost tests.
 
     python benchmarks/bench_batch.py [--students 8] [--jobs 1,2,4,8,auto] [--exercise EX ...]
 

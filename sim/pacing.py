@@ -429,9 +429,8 @@ class Pacer:
                     outcome = "budget" if any(s.busy for s in states.values()) else "idle"
                     break
                 awaited = True
-                clock.sleep(policy.poll_interval)
-                continue
-            late = late or not working
+            else:
+                late = late or not working
             clock.sleep(policy.poll_interval)
         self.receipts_awaited += awaited
         burst = False

@@ -113,20 +113,20 @@ class Receiving:
             fd = self._threads.pop(tid)
             if fd is not None:
                 os.close(fd)
-        busy = False
         for tid in tids:
             if tid not in self._threads:
                 self._threads[tid] = self._open_if_receiving(tid)
             fd = self._threads[tid]
-            if fd is None or busy:
+            if fd is None:
                 continue
             try:
-                busy = _thread_running(os.pread(fd, 4096, 0))
+                if _thread_running(os.pread(fd, 4096, 0)):
+                    return True
             except OSError:  # ended, or its number reused: look again next time
                 os.close(self._threads.pop(tid))
             except (ValueError, IndexError):
                 continue
-        return busy
+        return False
 
     def _open_if_receiving(self, tid: str) -> int | None:
         try:
