@@ -347,10 +347,10 @@ def bundle_gradescope(exercise: str, zip_path: Path) -> None:
 @main.command("grade-batch")
 @click.argument("item", metavar="EXERCISE_OR_QUIZ")
 @click.argument("submissions", type=click.Path(path_type=Path, file_okay=False, exists=True))
-@click.option("--jobs", type=_JOBS, default="1", show_default=True,
+@click.option("--jobs", type=_JOBS, default="auto", show_default=True,
               help="Gradings run at the same time (each on its own ROS domain), or 'auto': "
                    "grade the first student alone and choose from its CPU use and the "
-                   "machine's cores and memory.")
+                   "machine's cores and memory (quizzes: one at a time).")
 @click.option("--csv", "csv_path", type=click.Path(path_type=Path, dir_okay=False),
               required=True, help="The gradebook CSV (merged into if it exists).")
 @click.option("--out", type=click.Path(path_type=Path, file_okay=False), default=None,
@@ -375,6 +375,8 @@ def grade_batch(item: str, submissions: Path, jobs: int | str, csv_path: Path, o
         raise UsageProblem(_("--shard must be I/N with 1 <= I <= N, got {value}").format(
             value=shard)) from None
     out = out or Path("grades") / item
+    if jobs == "auto" and _exercise_or_none(item) is None:
+        jobs = 1  # a quiz scores in milliseconds, in this process: nothing to share
     if module_jobs is None:  # several gradings at once already keep the cores busy
         module_jobs = "auto" if jobs == 1 else 1
     grade_one, suffix, extra = _batch_item(item, record, module_jobs)
@@ -395,6 +397,14 @@ def grade_batch(item: str, submissions: Path, jobs: int | str, csv_path: Path, o
         count=len(rows), path=csv_path))
 
 
+def _exercise_or_none(item: str):  # noqa: ANN202 - an Exercise, or None
+    """The exercise ``item`` names, or None (a quiz, or nothing)."""
+    try:
+        return _exercise(item)
+    except UsageProblem:
+        return None
+
+
 def _batch_item(item: str, record: Path | None = None,  # noqa: ANN202
                 module_jobs: int | str = "auto"):
     """How to grade one student's entry for an exercise or a quiz (``record``: a folder
@@ -404,10 +414,7 @@ def _batch_item(item: str, record: Path | None = None,  # noqa: ANN202
     from autograder.quiz.scoring import read_answers, score
     from autograder.render import formats
 
-    try:
-        exercise = _exercise(item)
-    except UsageProblem:
-        exercise = None
+    exercise = _exercise_or_none(item)
     if exercise is not None:
         def extra(result, folder: Path) -> None:  # noqa: ANN001
             # Every format with a file per student; results.json is the batch's own

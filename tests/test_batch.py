@@ -265,6 +265,7 @@ def test_quiz_answers_go_into_the_same_gradebook(tmp_path, course_env):
                   str(tmp_path / "q")], env, cwd=Path(__file__).parent.parent)
     output, _ = proc.communicate(timeout=120)
     assert proc.returncode == 0, output
+    assert "--jobs auto" not in output  # the default, auto, scores a quiz one at a time
     with book.open() as fh:
         got = {(r["student"], r["item"]): (r["score"], r["passed"]) for r in csv.DictReader(fh)}
     assert got == {("amna", "shout"): ("3", "yes"), ("amna", "rclpy-part2"): ("5", "yes"),

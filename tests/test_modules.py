@@ -215,9 +215,9 @@ def test_a_child_that_broke_is_the_graders_fault_with_its_own_log() -> None:
 
 
 @pytest.mark.parametrize(("options", "expected"), [
-    ([], "auto"), (["--jobs", "2"], 1), (["--jobs", "auto"], 1),
+    (["--jobs", "1"], "auto"), (["--jobs", "2"], 1), ([], 1), (["--jobs", "auto"], 1),
     (["--jobs", "2", "--module-jobs", "3"], 3),
-], ids=["one-grading-at-a-time", "several", "auto", "explicit"])
+], ids=["one-grading-at-a-time", "several", "default-auto", "auto", "explicit"])
 def test_grade_batch_runs_modules_at_once_only_when_it_grades_one_at_a_time(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch, options: list[str],
         expected: int | str) -> None:
