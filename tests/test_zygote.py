@@ -2,7 +2,8 @@
 
 Each case runs the same program both ways (``AUTOGRADER_ZYGOTE=0`` execs it through the
 launcher) and compares what a grader sees: exit status, output, and the program's view
-of itself (argv, working folder, environment, module path, ``__name__``).
+of itself (argv, working folder, environment, module path, ``__name__``, the thread
+switch interval of :mod:`autograder.sandbox.runner`).
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ print("argv", [os.path.basename(sys.argv[0]), *sys.argv[1:]])
 print("cwd", os.getcwd() == os.path.dirname(os.path.abspath(__file__)))
 print("path0", sys.path[0] == os.path.dirname(__file__), __name__)
 print("env", os.environ["ROS_DOMAIN_ID"], os.environ["HOME"] == os.getcwd())
+print("switch", sys.getswitchinterval())
 """
 PROGRAMS = {
     # A node left undestroyed at exit: a fork without LTTng's hooks died of SIGSEGV here.
@@ -82,10 +84,12 @@ def test_a_forked_program_ends_as_an_execd_one(name: str, tmp_path: Path,
     assert isinstance(warm.popen, ForkedProcess)
     assert execd == forked == {"exit_code": 3, "crash": 1, "interrupted": -2}[name]
     assert forked_output == execd_output
-    assert "argv ['prog.py', '--ros-args']\ncwd True\npath0 True __main__\nenv 7 True\n" in (
-        forked_output)
+    assert ("argv ['prog.py', '--ros-args']\ncwd True\npath0 True __main__\nenv 7 True\n"
+            "switch 0.0005\n") in forked_output  # the GIL handed over within 0.5 ms (runner)
     if name != "exit_code":  # the traceback names the student's frames only
-        assert "zygote" not in forked_output and "prog.py" in forked_output
+        assert "prog.py" in forked_output
+        for ours in ("zygote", "runner", "<string>"):
+            assert ours not in forked_output and ours not in execd_output
 
 
 def test_a_failure_before_the_program_is_the_launchers_either_way(

@@ -29,6 +29,7 @@ from typing import Any
 
 from autograder.core.errors import GraderError
 from autograder.core.exercise import Limits
+from autograder.sandbox import runner
 from autograder.sandbox.cgroups import Cgroup
 
 _PASS_THROUGH = (
@@ -325,7 +326,7 @@ class StudentProcess:
         status_read, status_write = os.pipe()
         spec = {**spec, "status_fd": status_write}
         command = [sys.executable, "-m", "autograder.sandbox.launcher", json.dumps(spec), "--",
-                   student_python(), str(self.script), *args]
+                   *runner.command(student_python(), str(self.script), args)]
         try:
             popen = subprocess.Popen(
                 command, cwd=self.workdir, env=env, stdin=subprocess.DEVNULL,

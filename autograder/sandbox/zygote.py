@@ -34,9 +34,9 @@ import subprocess
 import sys
 import threading
 from collections.abc import Callable, Mapping, Sequence
-from pathlib import Path
 
 from autograder.sandbox.launcher import LAUNCH_FAILED, contain
+from autograder.sandbox.runner import run_program
 
 # What students' nodes import (the chapter's exercises and the book's code): imported once
 # here instead of in every program.  A missing one is skipped.
@@ -184,45 +184,6 @@ def _become_program(request: dict, fds: list[int]) -> tuple[str, list[str]]:
         os._exit(LAUNCH_FAILED)
     os.close(status)
     return request["script"], list(request["args"])
-
-
-def run_program(script: str, args: list[str]) -> None:
-    """Run ``script`` as ``python script args...`` runs it: as ``__main__``, its folder first
-    on the module path.  A KeyboardInterrupt ends it as CPython ends one (traceback, then
-    death by SIGINT once threads and exit handlers are done); any other exception prints
-    its traceback (the student's frames only) and exits with status 1."""
-    import types
-
-    sys.argv = [script, *args]
-    sys.path[0] = os.path.dirname(script)
-    main = types.ModuleType("__main__")
-    main.__file__ = script
-    main.__builtins__ = __builtins__
-    sys.modules["__main__"] = main
-    try:
-        code = compile(Path(script).read_bytes(), script, "exec")
-        exec(code, main.__dict__)  # noqa: S102 - running the student's program is the point
-    except SystemExit:
-        raise
-    except BaseException as exc:  # noqa: BLE001 - reported as the interpreter would
-        tb = exc.__traceback__.tb_next if exc.__traceback__ is not None else None
-        sys.excepthook(type(exc), exc.with_traceback(tb), tb)
-        if not isinstance(exc, KeyboardInterrupt):
-            sys.exit(1)
-        _exit_by_sigint()
-
-
-def _exit_by_sigint() -> None:
-    threading._shutdown()  # type: ignore[attr-defined]  # what Py_Finalize does first
-    import atexit
-
-    atexit._run_exitfuncs()
-    for stream in (sys.stdout, sys.stderr):
-        with contextlib.suppress(Exception):
-            stream.flush()
-    signal.signal(signal.SIGINT, signal.SIG_DFL)
-    os.kill(os.getpid(), signal.SIGINT)
-    os._exit(128 + signal.SIGINT)
 
 
 # -- the grader's side -----------------------------------------------------------------

@@ -1,0 +1,75 @@
+"""How a student's program is run, once contained: as ``python SCRIPT ARGS...`` runs it,
+with one difference, the interpreter's thread switch interval (:data:`SWITCH_INTERVAL`).
+
+CPython lets a thread keep the GIL for 5 ms while another waits for it.  Jazzy's
+``MultiThreadedExecutor`` (rclpy 7.1) spins while a callback it handed to a worker thread
+has not started (ros2/rclpy#1452, fixed after Jazzy by ros2/rclpy#1547), and the worker
+needs the GIL the spinning thread keeps: each handover could cost a spin of 5 ms.  The
+world holds simulation time for a busy program only up to a CPU share (``sim.pacing``), so
+such spins decided whether a correct multithreaded design kept its points, and the answer
+changed with how much CPU the grader itself used.  At 0.5 ms a waiting thread gets the GIL
+ten times sooner; a program with one Python thread never notices.
+
+The zygote calls :func:`run_program` in its forked child; a program that is exec'd runs
+this module's source through ``python -c`` (:func:`command`), since the student's user may
+not be able to read this package.  So this module uses the standard library only.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import signal
+import sys
+import threading
+import types
+
+SWITCH_INTERVAL = 0.0005
+"""Seconds a thread may hold the GIL while another waits (CPython's default: 0.005)."""
+
+
+def run_program(script: str, args: list[str]) -> None:
+    """Run ``script`` as ``python script args...`` runs it: as ``__main__``, its folder first
+    on the module path.  A KeyboardInterrupt ends it as CPython ends one (traceback, then
+    death by SIGINT once threads and exit handlers are done); any other exception prints
+    its traceback (the student's frames only) and exits with status 1."""
+    sys.setswitchinterval(SWITCH_INTERVAL)
+    sys.argv = [script, *args]
+    sys.path[0] = os.path.dirname(script)
+    main = types.ModuleType("__main__")
+    main.__file__ = script
+    main.__builtins__ = __builtins__  # type: ignore[attr-defined]
+    sys.modules["__main__"] = main
+    try:
+        with open(script, "rb") as source:
+            code = compile(source.read(), script, "exec")
+        exec(code, main.__dict__)  # noqa: S102 - running the student's program is the point
+    except SystemExit:
+        raise
+    except BaseException as exc:  # noqa: BLE001 - reported as the interpreter would
+        tb = exc.__traceback__.tb_next if exc.__traceback__ is not None else None
+        sys.excepthook(type(exc), exc.with_traceback(tb), tb)
+        if not isinstance(exc, KeyboardInterrupt):
+            sys.exit(1)
+        _exit_by_sigint()
+
+
+def _exit_by_sigint() -> None:
+    threading._shutdown()  # type: ignore[attr-defined]  # what Py_Finalize does first
+    import atexit
+
+    atexit._run_exitfuncs()
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(Exception):
+            stream.flush()
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+    os.kill(os.getpid(), signal.SIGINT)
+    os._exit(128 + signal.SIGINT)
+
+
+def command(python: str, script: str, args: list[str]) -> list[str]:
+    """The command that runs ``script`` with ``args`` through :func:`run_program`."""
+    with open(__file__, encoding="utf-8") as source:
+        program = source.read()
+    return [python, "-c", f"{program}\nrun_program(sys.argv[1], sys.argv[2:])\n", script,
+            *args]
