@@ -136,10 +136,14 @@ class PacingPolicy:
     """Most CPU seconds a watched process may bank, beyond ``cpu_budget``, for a burst."""
     poll_interval: float = 0.0005
     """Pause between two readings of the watched processes while holding a tick (a
-    reading of a 16-thread rclpy process takes about 0.56 ms more).  Reading through
-    files kept open (90 us) every 1 ms, shipped for two stops, let Jazzy's
-    MultiThreadedExecutor spin far longer in a hold, unexplained: a correct node then
-    lost points alone (README, "Pacing")."""
+    reading of a 16-thread rclpy process takes about 0.22 ms more).  Cheaper looks once
+    let Jazzy's MultiThreadedExecutor spin past its share, until students' programs got a
+    shorter GIL switch interval (:mod:`autograder.sandbox.runner`; README, "Pacing")."""
+    starved_poll_max: float = 0.004
+    """Longest pause between two readings while every busy watched process waits for a
+    CPU (its CPU time did not grow since the reading before): the pause doubles from
+    ``poll_interval`` up to this, so that on a machine short of CPU the world's readings
+    leave the cores to the processes it waits for."""
     max_tick: float = 2.0
     """Longest tick at RTF 0, in sim seconds."""
     receive_timeout: float = 0.5
@@ -411,8 +415,11 @@ class Pacer:
         receipt_cap: float | None = None  # set once the processes are done
         awaited = False
         states: dict[int, ProcessState] = {}
+        pause = policy.poll_interval
         while (now := clock.monotonic()) < cap:
-            states = {pid: self._read(pid) for pid in pids}
+            previous, states = states, {pid: self._read(pid) for pid in pids}
+            pause = (min(2 * pause, policy.starved_poll_max)
+                     if _starved(previous, states) else policy.poll_interval)
             for pid, state in states.items():
                 heard[pid] = heard[pid] or (not state.exists or state.busy
                                             or state.cpu_ns > baseline[pid])
@@ -431,7 +438,7 @@ class Pacer:
                 awaited = True
             else:
                 late = late or not working
-            clock.sleep(policy.poll_interval)
+            clock.sleep(pause)
         self.receipts_awaited += awaited
         burst = False
         with self.condition:
@@ -449,3 +456,13 @@ class Pacer:
         ended = clock.monotonic()
         self.longest_hold = max(self.longest_hold, ended - published)
         self.held_seconds += max(0.0, ended - max(deadline, published))
+
+
+def _starved(before: dict[int, ProcessState], now: dict[int, ProcessState]) -> bool:
+    """Some process is busy, and none that is busy has run since the reading ``before``:
+    they all wait for a CPU.  A thread's CPU time moves at the scheduler's events, so one
+    that is running may read as waiting for a while; the pause then stays within
+    ``starved_poll_max``."""
+    busy = [pid for pid, state in now.items() if state.busy]
+    return bool(busy) and all(pid in before and now[pid].cpu_ns == before[pid].cpu_ns
+                              for pid in busy)

@@ -281,6 +281,47 @@ def test_a_starved_process_holds_until_the_cap() -> None:
     assert run.pacer.effective_rtf < 0.1  # 0.02 s of sim time per 2 s held
 
 
+def test_readings_of_a_starved_process_back_off_to_the_most_allowed() -> None:
+    """While the process waits for a CPU, the pause between readings doubles up to
+    ``starved_poll_max``: the world leaves the cores to the processes it waits for."""
+    clock = FakeClock()
+    readings: list[float] = []
+    starved = FakeProcess(clock, cpu_share=0.0)
+
+    def read(pid: int) -> ProcessState:
+        readings.append(clock.now)
+        return starved(pid)
+
+    run = Run(Pacer(DT, 1.0, PacingPolicy(clock_hz=50.0), clock=clock, read_process=read),
+              clock)
+    run.pacer.watch(4242)
+    run.tick()
+    assert run.pacer.counts == {"cap": 1}  # the same outcome as reading every 0.5 ms
+    pauses = [round(b - a, 6) for a, b in zip(readings[1:], readings[2:], strict=False)]
+    assert pauses[:5] == [0.0005, 0.001, 0.002, 0.004, 0.004]  # from the first look on
+    assert set(pauses[3:]) == {0.004}
+    assert len(readings) < 2.0 / 0.004 + 5  # about 500 readings in the 2 s cap, not 4000
+
+
+def test_a_process_that_computes_is_read_every_poll_interval() -> None:
+    """A process whose CPU time grows is read at ``poll_interval``, as before."""
+    clock = FakeClock()
+    readings: list[float] = []
+    busy = FakeProcess(clock, idle_at=clock.now + 0.01)
+
+    def read(pid: int) -> ProcessState:
+        readings.append(clock.now)
+        return busy(pid)
+
+    run = Run(Pacer(DT, 1.0, PacingPolicy(clock_hz=50.0), clock=clock, read_process=read),
+              clock)
+    run.pacer.watch(4242)
+    run.tick()
+    assert run.pacer.counts == {"idle": 1}
+    pauses = {round(b - a, 6) for a, b in zip(readings[1:], readings[2:], strict=False)}
+    assert pauses == {0.0005}
+
+
 def test_held_seconds_count_holds_past_the_deadline_only() -> None:
     """A hold within the tick's period costs no wall time; past it, every second counts."""
     clock = FakeClock()
