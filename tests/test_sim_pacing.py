@@ -281,19 +281,23 @@ def test_a_starved_process_holds_until_the_cap() -> None:
     assert run.pacer.effective_rtf < 0.1  # 0.02 s of sim time per 2 s held
 
 
+def _timed_readings(clock: FakeClock, process: FakeProcess) -> tuple[Run, list[float]]:
+    """A run whose pacer reads ``process``, and the fake times of its readings."""
+    readings: list[float] = []
+
+    def read(pid: int) -> ProcessState:
+        readings.append(clock.now)
+        return process(pid)
+
+    pacer = Pacer(DT, 1.0, PacingPolicy(clock_hz=50.0), clock=clock, read_process=read)
+    return Run(pacer, clock), readings
+
+
 def test_readings_of_a_starved_process_back_off_to_the_most_allowed() -> None:
     """While the process waits for a CPU, the pause between readings doubles up to
     ``starved_poll_max``: the world leaves the cores to the processes it waits for."""
     clock = FakeClock()
-    readings: list[float] = []
-    starved = FakeProcess(clock, cpu_share=0.0)
-
-    def read(pid: int) -> ProcessState:
-        readings.append(clock.now)
-        return starved(pid)
-
-    run = Run(Pacer(DT, 1.0, PacingPolicy(clock_hz=50.0), clock=clock, read_process=read),
-              clock)
+    run, readings = _timed_readings(clock, FakeProcess(clock, cpu_share=0.0))
     run.pacer.watch(4242)
     run.tick()
     assert run.pacer.counts == {"cap": 1}  # the same outcome as reading every 0.5 ms
@@ -306,15 +310,7 @@ def test_readings_of_a_starved_process_back_off_to_the_most_allowed() -> None:
 def test_a_process_that_computes_is_read_every_poll_interval() -> None:
     """A process whose CPU time grows is read at ``poll_interval``, as before."""
     clock = FakeClock()
-    readings: list[float] = []
-    busy = FakeProcess(clock, idle_at=clock.now + 0.01)
-
-    def read(pid: int) -> ProcessState:
-        readings.append(clock.now)
-        return busy(pid)
-
-    run = Run(Pacer(DT, 1.0, PacingPolicy(clock_hz=50.0), clock=clock, read_process=read),
-              clock)
+    run, readings = _timed_readings(clock, FakeProcess(clock, idle_at=clock.now + 0.01))
     run.pacer.watch(4242)
     run.tick()
     assert run.pacer.counts == {"idle": 1}
