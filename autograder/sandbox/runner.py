@@ -18,6 +18,7 @@ not be able to read this package.  So this module uses the standard library only
 from __future__ import annotations
 
 import contextlib
+import functools
 import os
 import signal
 import sys
@@ -67,9 +68,13 @@ def _exit_by_sigint() -> None:
     os._exit(128 + signal.SIGINT)
 
 
+@functools.cache
+def _program() -> str:
+    """This module's source and a call of :func:`run_program` (read once per grader)."""
+    with open(__file__, encoding="utf-8") as source:
+        return f"{source.read()}\nrun_program(sys.argv[1], sys.argv[2:])\n"
+
+
 def command(python: str, script: str, args: list[str]) -> list[str]:
     """The command that runs ``script`` with ``args`` through :func:`run_program`."""
-    with open(__file__, encoding="utf-8") as source:
-        program = source.read()
-    return [python, "-c", f"{program}\nrun_program(sys.argv[1], sys.argv[2:])\n", script,
-            *args]
+    return [python, "-c", _program(), script, *args]
