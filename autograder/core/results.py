@@ -11,6 +11,7 @@ from decimal import Decimal
 from fractions import Fraction
 from typing import Any, Literal
 
+from autograder.core.untrusted import visible
 from autograder.i18n import _, ngettext
 
 Status = Literal["passed", "failed", "error", "skipped"]
@@ -57,6 +58,10 @@ class TestResult:
     reveal: Reveal = "message"
     details: str = ""
     data: dict[str, Any] = dataclasses.field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        # What a test says may quote a program's output: every format shows it harmless.
+        _show_visible(self, "message", "hint", "details")
 
     @property
     def passed(self) -> bool:
@@ -107,6 +112,17 @@ class NotRun:
         return _("The grade also runs hidden tests.")
 
 
+def _show_visible(result: object, *fields: str) -> None:
+    """Make a result's ``fields`` (text a program may have written) safe to show anywhere:
+    a program's escape sequences and bidi controls as visible escapes
+    (:func:`autograder.core.untrusted.visible`). Our own messages hold none of these; the
+    right-to-left marks a terminal needs are added later, by the terminal renderer."""
+    for name in fields:
+        value = getattr(result, name)
+        if isinstance(value, str):
+            object.__setattr__(result, name, visible(value))
+
+
 _RUN_DATA = ("isolation", "pacing", "bags", "warnings", "timing", "memory")
 """What :meth:`RunResult.to_dict` writes from ``data``, and ``from_dict`` reads back."""
 
@@ -132,6 +148,9 @@ class RunResult:
     # Set for a partial run (``check``): what the grade runs beyond it. A partial run
     # proves nothing about passing, so it never says passed.
     not_run: NotRun | None = None
+
+    def __post_init__(self) -> None:
+        _show_visible(self, "log", "log_tail", "grader_details")
 
     @property
     def complete(self) -> bool:

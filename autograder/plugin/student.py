@@ -14,6 +14,7 @@ import pytest
 
 from autograder.core.errors import StudentFailure
 from autograder.core.output import TAIL_BYTES, TAIL_LINES, describe_exit, message_tail, size_note
+from autograder.core.untrusted import visible
 from autograder.i18n import _
 from autograder.plugin.probe import GRADER_NODES
 from autograder.plugin.stash import reporter_key, settings_key, startup_key
@@ -62,8 +63,9 @@ class StudentNode:
 
     def output_tail(self, lines: int = TAIL_LINES, max_bytes: int = TAIL_BYTES) -> str:
         """The end of the program's output, short enough for a test message (a few lines,
-        a few KB), saying so when the program wrote more than the sandbox kept."""
-        tail = message_tail(self.output(), lines, max_bytes)
+        a few KB), saying so when the program wrote more than the sandbox kept; shown
+        :func:`visible` first, so that those limits count what the student reads."""
+        tail = message_tail(visible(self.output()), lines, max_bytes)
         output = self.process.output
         note = size_note(output.total, output.budget) if output is not None else ""
         return "\n".join(part for part in (tail, note) if part)

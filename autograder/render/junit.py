@@ -5,6 +5,7 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 
 from autograder.core.results import RunResult, number
+from autograder.core.untrusted import visible
 from autograder.render import OutputFormat
 
 
@@ -46,8 +47,20 @@ def to_junit(result: RunResult) -> str:
         ET.SubElement(suite, "system-err").text = result.grader_details
     if result.log_tail:
         ET.SubElement(suite, "system-out").text = result.log_tail
+    _well_formed(suites)
     ET.indent(suites)
     return ET.tostring(suites, encoding="unicode", xml_declaration=True) + "\n"
+
+
+def _well_formed(root: ET.Element) -> None:
+    """Every text and attribute under ``root`` as :func:`visible` shows it: the results
+    model holds such text already, but a CI reporter that meets one NUL or ESC in the file
+    gives up on the whole student, so nothing that reaches this file goes unchecked."""
+    for element in root.iter():
+        if element.text:
+            element.text = visible(element.text)
+        for name, value in element.attrib.items():
+            element.attrib[name] = visible(value)
 
 
 def _first_line(message: str) -> str:
