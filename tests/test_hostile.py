@@ -249,3 +249,53 @@ def test_runs_as_its_own_user_where_strict(graded):
         assert result.data["student_uid"] is None
         assert seen == {os.getuid()}
         assert isolation["reason"]  # the results say why
+
+
+def test_output_that_lies_shows_as_text(graded):
+    """A program that clears the screen and prints a fake full score, sets the window's
+    title, hides text, plants a link and reverses a line: every format shows all of it as
+    text, and its NUL and BEL leave the JUnit XML well-formed."""
+    import unicodedata
+    import xml.etree.ElementTree as ET
+
+    from autograder.render.gradescope import to_gradescope
+    from autograder.render.jsonfile import to_json
+    from autograder.render.junit import to_junit
+
+    result = graded["fake_score"][0]
+    assert result.score == result.max_score  # it works; only its output lies
+    shown = {"terminal": to_terminal(result), "junit": to_junit(result),
+             "gradescope": to_gradescope(result), "results": to_json(result),
+             "log": result.log}
+    for name, text in shown.items():
+        assert not {c for c in text if unicodedata.category(c) in ("Cc", "Cf", "Cs")
+                    and c not in "\n\t"}, name
+    ET.fromstring(shown["junit"].encode("utf-8"))  # well-formed, as a CI reporter reads it
+    for text in (result.log, shown["junit"]):  # the lie is there, to be read
+        assert "\\x1b[2J\\x1b[H" in text and "\\x1b]0;autograder: all tests passed\\x07" in text
+        assert "\\u202edessap stset lla\\u202c" in text and "NUL\\x00 BEL\\x07 CR" in text
+    # The log tail (JUnit's system-out) is cut by lines, so there a lone CR ends a line.
+    assert "CR\\r overwritten" in result.log and "C1 CSI \\x9b2J" in result.log
+
+
+# Issue 28: the grader's nodes take no orders, and the graph is watched through each test.
+def test_the_graders_nodes_serve_no_parameters(graded):
+    """A program that tries to turn off use_sim_time on the world and the probe finds no
+    service to call; it answers correctly otherwise, for full marks."""
+    result = graded["sets_grader_params"][0]
+    assert result.score == result.max_score
+    for node in ("/sim_world", "/autograder_probe"):
+        assert f"PARAMS: no service {node}/set_parameters" in result.log
+    assert "PARAMS: changed" not in result.log and "PARAMS: refused" not in result.log
+
+
+def test_a_clock_faked_for_a_moment_fails_the_tests_it_was_faked_in(graded):
+    """/clock published for 0.3 s while a test waits for its answer fails that test (in
+    each module, the one that sends the message); the test before it still passes."""
+    result = graded["fakes_clock_briefly"][0]
+    assert result.log.count("FAKE CLOCK: published for") == 2
+    tests = {test.name: test for test in result.tests}
+    assert tests["test_starts"].passed
+    for name in ("test_upper_case", "test_once_per_message"):
+        assert not tests[name].passed
+        assert "Tampering with the simulated world" in tests[name].message, name
