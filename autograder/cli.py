@@ -155,14 +155,14 @@ def _run(exercise: str, submission: Path, hidden: bool, outputs: dict[str, Path 
          rtf: float | None, domain: int | None, record: Path | None = None,
          module_jobs: int | str = "auto") -> None:
     from autograder.core.report import RawTest
-    from autograder.core.submission import SubmissionNotFound, locate
+    from autograder.core.submission import SubmissionNotFound, check
     from autograder.grading.run import grade, result_of
     from autograder.render.live import LiveLines, terminal_style
     from autograder.render.terminal import for_terminal, heading, rtl_notice, to_terminal
 
     found = _exercise(exercise)
     try:
-        locate(submission, found.file)
+        check(submission, found.file)  # a link, device or FIFO: the student's clear error
     except SubmissionNotFound as exc:
         raise UsageProblem(str(exc)) from None
     color, in_place = terminal_style(sys.stdout)

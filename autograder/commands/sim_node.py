@@ -159,6 +159,16 @@ class NodeRun:
         return notes
 
 
+def _refuse_unreadable(node_file: Path) -> None:
+    """A link, device or FIFO as the node file (or beside it) is refused, as grading does."""
+    from autograder.core.submission import SubmissionRefused, read_submission
+
+    try:
+        read_submission(node_file, node_file.name)
+    except SubmissionRefused as exc:
+        raise UsageProblem(str(exc)) from None
+
+
 def _check_syntax(script: Path) -> None:
     """A syntax error is said at once, as grading says it, instead of after a start-up."""
     try:
@@ -242,6 +252,7 @@ def add_node_options(run: click.Command) -> None:
             if exercise is not None or params:
                 raise click.UsageError(_("--exercise and --param go with --node FILE."))
             return original(**kwargs)
+        _refuse_unreadable(node_file)
         _check_syntax(node_file)  # before the world: nothing to watch
         found = node_exercise(node_file, exercise)
         if found is not None:
