@@ -211,6 +211,7 @@ def write_outputs(result, outputs: dict[str, Path | None], folder: Path) -> None
     """Write each requested output format of ``result`` (``--results``, ``--html``, ...:
     see :mod:`autograder.render`); with ``--results FILE``, the programs' whole output goes
     to FILE with suffix ``.log`` (``log`` names another file for it)."""
+    from autograder.core.files import write_atomically
     from autograder.core.output import log_beside
     from autograder.render import formats
 
@@ -222,7 +223,7 @@ def write_outputs(result, outputs: dict[str, Path | None], folder: Path) -> None
             continue
         path.parent.mkdir(parents=True, exist_ok=True)
         text = result.log if name == "log" else formats()[name].render(result, folder)
-        path.write_text(text, encoding="utf-8")
+        write_atomically(path, text)
 
 
 def _formats(func):  # noqa: ANN001, ANN202

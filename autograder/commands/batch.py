@@ -19,6 +19,7 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 from autograder.commands import gradebook
+from autograder.core.files import write_atomically
 from autograder.core.results import RunResult
 from autograder.grading.capacity import measured
 
@@ -65,11 +66,9 @@ def _save(out: Path, student: str, result: RunResult,
     folder.mkdir(parents=True, exist_ok=True)
     if extra is not None:
         extra(result, folder)
-    path = _results_path(out, student)
-    tmp = path.with_suffix(".tmp")
-    tmp.write_text(json.dumps(result.to_dict(), ensure_ascii=False, indent=2) + "\n",
-                   encoding="utf-8")
-    tmp.replace(path)  # last: its presence means this student is done
+    # Last: its presence means this student is done.
+    write_atomically(_results_path(out, student),
+                     json.dumps(result.to_dict(), ensure_ascii=False, indent=2) + "\n")
 
 
 def run_batch(entries: dict[str, Path], grade_one: Callable[[Path], RunResult], out: Path,

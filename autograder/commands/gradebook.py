@@ -9,11 +9,11 @@ from __future__ import annotations
 
 import csv
 import io
-import os
 from collections.abc import Iterable
 from pathlib import Path
 
 from autograder.core.errors import ContentError
+from autograder.core.files import write_atomically
 from autograder.core.results import RunResult, number
 from autograder.i18n import _
 
@@ -64,6 +64,4 @@ def write(path: Path, rows: list[Row]) -> None:
     writer.writeheader()
     writer.writerows(rows)
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    tmp.write_text(buffer.getvalue(), encoding="utf-8")
-    tmp.replace(path)
+    write_atomically(path, buffer.getvalue())
