@@ -232,6 +232,64 @@ def test_no_network_beyond_loopback(graded, target_host):
     assert b"leaked" not in target_host.read_bytes()
 
 
+def test_modules_beside_the_node_run_only_as_the_student(graded):
+    """json.py, ctypes.py, sitecustomize.py... beside the node: imported by the student's
+    own program at most, never by the launcher as root (issue 28)."""
+    result = graded["shadows_stdlib"][0]
+    assert result.score == result.max_score and result.grader_error is None
+    assert "ROOT CODE RAN" not in result.log
+    importers = re.findall(r"^SHADOW (\w+) IMPORTED AS UID (\d+)$", result.log, re.M)
+    assert {name for name, _uid in importers} <= {"json"}  # the node's own imports only
+    if result.data["isolation"]["mode"] == "strict":
+        assert {int(uid) for _name, uid in importers} <= set(result.data["student_uids"])
+
+
+@strict_only
+def test_ipc_objects_and_scratch_files_go_with_the_program(graded):
+    """SysV shared memory, queues and semaphores, a POSIX queue and files in /dev/shm and
+    /tmp: the program's own namespaces held them, and none is on the machine after."""
+    result = graded["ipc_leftovers"][0]
+    assert result.score == result.max_score
+    keys = {int(key, 16) for key in re.findall(r"^IPC SHM (0x[0-9a-f]+)", result.log, re.M)}
+    assert keys, "the program made its segments"
+    for kind in ("shm", "msg", "sem"):
+        with open(f"/proc/sysvipc/{kind}") as fh:
+            left = {int(row.split()[0]) for row in list(fh)[1:]}
+        assert not left & keys, kind
+    names = re.findall(r"^(?:FILE LEFT|IPC MQ) (\S+)", result.log, re.M)
+    assert names
+    for name in names:
+        assert not Path(name).exists() and not Path("/dev/mqueue", name.lstrip("/")).exists()
+
+
+@strict_only
+def test_the_machines_processes_are_out_of_sight_and_reach(graded):
+    """No other user's process is listed, stopped or traced; no privilege can be gained."""
+    result = graded["snoops_processes"][0]
+    assert result.score == result.max_score
+    assert "GRADER COMMAND LINE" not in result.log
+    assert re.findall(r"^PROCESSES SEEN \d+ FOREIGN (\d+) STOPPED (\d+)$", result.log,
+                      re.M) and "FOREIGN 0 STOPPED 0" in result.log
+    assert "NoNewPrivs:\t1" in result.log
+    assert "TRACED 0" in result.log
+
+
+@strict_only
+def test_without_cgroups_a_daemon_still_ends_with_the_program(course, monkeypatch):
+    """Where no cgroup can be made (a container's read-only cgroup filesystem), what left
+    the process group is ended by its user: nothing of the run's users is left."""
+    monkeypatch.setenv("AUTOGRADER_CGROUP_ROOT", "/nonexistent")
+    result = grade(course, CORPUS / "detached_daemon")
+    assert result.grader_error is None
+    assert result.data["isolation"]["bounds"]["cgroup"] is None  # it really had none
+    assert re.search(r"^STUDENT UID \d+$", result.log, re.M), "the daemon started"
+    assert leftovers(result) == []
+    from autograder.sandbox.sweep import user_processes
+
+    for uid in result.data["student_uids"]:
+        assert user_processes(uid) == []
+
+
 def test_runs_as_its_own_user_where_strict(graded):
     """The program (and the daemon it leaves behind) prints the uid it really runs as:
     the run's own user in strict isolation, never the grader's; the grader's user in basic

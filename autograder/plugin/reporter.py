@@ -79,12 +79,15 @@ class GradingReporter:
         self.write()
 
     def note_process(self, pid: int, cgroups: list[str], bounds: dict[str, Any],
-                     workdir: str | None = None) -> None:
+                     workdir: str | None = None, uid: int | None = None) -> None:
         """Record a student process so the parent can reap it if this run is killed (and
-        remove its folder outside the run's, ``workdir``), and say which bounds held it."""
+        remove its folder outside the run's, ``workdir``, and end every process of its own
+        user, ``uid``), and say which bounds held it."""
         record = {"pid": pid, "cgroups": cgroups, "bounds": bounds}
         if workdir is not None:
             record["workdir"] = workdir
+        if uid is not None:
+            record["uid"] = uid
         self.data["processes"].append(record)
         self.write()
 

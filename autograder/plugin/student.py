@@ -139,7 +139,7 @@ def _launch(request: pytest.FixtureRequest, exercise: Exercise, script: Path, pr
             # RLIMIT_NPROC binds every user but root: a uid of the student's own, or an
             # ordinary grading user (where it counts that user's other processes too).
             process.cgroup.bounds(separate_uid=process.uid is not None or os.geteuid() != 0),
-            str(process.workdir) if process.uid is not None else None)
+            str(process.workdir) if process.uid is not None else None, process.uid)
     process.start()
     world.watch_pid(process.pid)
     node = StudentNode(process, exercise.node, probe, _log_keeper(request),

@@ -27,8 +27,8 @@ import sys
 from pathlib import Path
 
 from autograder.i18n import N_
-
-STUDENT_UID_BASE = 200_000
+from autograder.sandbox.privileged import PACKAGE_PARENT, SAFE_CWD, module_command
+from autograder.sandbox.sweep import STUDENT_UID_BASE
 
 
 @dataclasses.dataclass(frozen=True)
@@ -69,9 +69,8 @@ def detect() -> Isolation:
         return Isolation(False, N_("the unshare command (util-linux) is missing"))
     try:
         probe = subprocess.run(
-            [*run_prefix(Isolation(True)), sys.executable, "-m", "autograder.sandbox.isolation"],
-            capture_output=True, text=True, timeout=120,
-            env=dict(os.environ, PYTHONPATH=_package_parent()))
+            [*run_prefix(Isolation(True)), *module_command("autograder.sandbox.isolation", [])],
+            capture_output=True, text=True, timeout=120, cwd=SAFE_CWD)
     except subprocess.TimeoutExpired:
         return Isolation(False, N_("a test program could not run in strict isolation"),
                          "no answer within 120 s")
@@ -110,7 +109,7 @@ def probe_launch() -> str | None:
         script.parent.mkdir()
         script.write_text(PROBE_PROGRAM)
         process = student_process(script, [], Limits(), domain=0, strict=True,
-                                  course=Path(_package_parent()))
+                                  course=Path(PACKAGE_PARENT))
         try:
             process.start()
         except LaunchFailed as exc:
@@ -125,10 +124,6 @@ def probe_launch() -> str | None:
             return None
         return (f"the test program exited with status {status}: "
                 f"{process.output_tail(3) or '(no output)'}")
-
-
-def _package_parent() -> str:
-    return str(Path(__file__).resolve().parents[2])
 
 
 def run_prefix(isolation: Isolation) -> list[str]:
@@ -171,7 +166,7 @@ def bring_up_loopback() -> None:
 def protected_paths(course: Path) -> list[Path]:
     """What the student must not read: hidden tests, solutions, quiz keys, our own tests
     and history — in the course being graded and in the checkout the platform runs from."""
-    roots = dict.fromkeys((course.resolve(), Path(_package_parent())))
+    roots = dict.fromkeys((course.resolve(), Path(PACKAGE_PARENT)))
     return [p for root in roots for p in (root / "assignments", root / "tests", root / ".git",
                                           root / "quizzes") if p.exists()]
 

@@ -6,10 +6,16 @@ grader) and ``exec``s the student's command once it is contained::
     python -m autograder.sandbox.launcher SPEC_JSON -- COMMAND...
 
 SPEC holds ``limits`` (see ``autograder.core.exercise.Limits``), ``cgroups`` (folders to
-join) and ``status_fd``, and for strict isolation ``uid``, ``hide`` (paths to cover with
-an empty read-only filesystem), ``workdir`` and ``workdir_mb`` (a tmpfs of that size,
-owned by ``uid``, filled with the files staged there).  Strict steps need root; the
-mounts happen in a mount namespace of the student's own, so the grader keeps its view.
+join), ``workdir`` (where the program runs) and ``status_fd``, and for strict isolation
+``uid``, ``hide`` (paths to cover with an empty read-only filesystem) and ``workdir_mb``
+(``workdir`` becomes a tmpfs of that size, owned by ``uid``, filled with the files staged
+there).  Strict steps need root; the mounts happen in mount and IPC namespaces of the
+student's own, with a ``/proc`` showing only the student's processes, so the grader
+keeps its view.  Every program runs with no new privileges.
+
+The launcher is started isolated, from ``/`` (:mod:`autograder.sandbox.privileged`): it
+runs as root until the program is contained, so nothing of the student's may be on its
+module path.
 
 ``status_fd`` is the write end of a pipe, close-on-exec, as :mod:`subprocess` does it: if
 anything fails before the student's program is exec'd (a mount, a cgroup, setuid, a
@@ -21,6 +27,7 @@ of ours for the student's program exiting.
 from __future__ import annotations
 
 import ctypes
+import errno
 import json
 import os
 import resource
@@ -34,7 +41,8 @@ _RLIMITS = {
     "open_files": (resource.RLIMIT_NOFILE, 1),
     "file_size_mb": (resource.RLIMIT_FSIZE, 1024 * 1024),
 }
-CLONE_NEWNS = 0x00020000
+CLONE_NEWNS, CLONE_NEWIPC = 0x00020000, 0x08000000
+PR_SET_NO_NEW_PRIVS = 38
 MS_RDONLY, MS_NOSUID, MS_NODEV, MS_NOEXEC = 1, 2, 4, 8
 MS_REMOUNT, MS_BIND, MS_REC, MS_PRIVATE = 32, 4096, 0x4000, 1 << 18
 # Exit status of a launcher that failed before the exec (what failed is on the status pipe).
@@ -95,9 +103,32 @@ def _mount(source: str, target: str, fstype: str | None, flags: int, data: str |
 
 
 def private_mounts() -> None:
-    """A mount namespace of our own, whose changes never reach the grader's."""
-    _check(_libc().unshare(CLONE_NEWNS), "unshare")
+    """A mount namespace of our own, whose changes never reach the grader's, and an IPC
+    namespace: SysV shared memory, queues and semaphores and POSIX message queues the
+    program makes are its own, and the kernel destroys them with its last process."""
+    _check(_libc().unshare(CLONE_NEWNS | CLONE_NEWIPC), "unshare")
     _mount("none", "/", None, MS_REC | MS_PRIVATE, None)
+
+
+def private_proc() -> bool:
+    """A ``/proc`` of the program's own in which only its user's processes appear
+    (``hidepid=invisible``): not the grader's, not other runs' command lines. Each such
+    mount has its options to itself since Linux 5.8; an older kernel refuses the option
+    (EINVAL), and then ``/proc`` stays as it is (False): an older kernel would apply it to
+    the machine's own ``/proc``."""
+    try:
+        _mount("proc", "/proc", "proc", MS_NOSUID | MS_NODEV | MS_NOEXEC, "hidepid=invisible")
+    except OSError as exc:
+        if exc.errno == errno.EINVAL:
+            return False
+        raise
+    return True
+
+
+def no_new_privileges() -> None:
+    """No exec of the program or of anything it starts gains privileges (set-user-ID
+    programs, file capabilities): ``PR_SET_NO_NEW_PRIVS``."""
+    _check(_libc().prctl(PR_SET_NO_NEW_PRIVS, 1, 0, 0, 0), "prctl(PR_SET_NO_NEW_PRIVS)")
 
 
 # What a student's program may see of the machine: the system, and what it runs on.
@@ -237,6 +268,8 @@ def contain(spec: dict, stage: list[str]) -> None:
         stage[0] = "working directory"
         fill_workdir(spec["workdir"], int(spec.get("workdir_mb", 64)), uid,
                      interpreter_paths())
+        stage[0] = "a /proc of its own"
+        private_proc()
     stage[0] = "cgroup"
     for cgroup in spec.get("cgroups", []):
         with open(os.path.join(cgroup, "cgroup.procs"), "w") as fh:
@@ -246,10 +279,13 @@ def contain(spec: dict, stage: list[str]) -> None:
     if uid is not None:
         limits["uid"] = uid
     apply_limits(limits)
+    stage[0] = "no new privileges"
+    no_new_privileges()
     if uid is not None:
         stage[0] = "switching to the student's user"
         become(uid)
-        os.chdir(spec["workdir"])
+    stage[0] = "working directory"
+    os.chdir(spec["workdir"])  # only now: the launcher itself started from "/"
 
 
 def main(argv: list[str]) -> None:

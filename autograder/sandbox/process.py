@@ -31,6 +31,8 @@ from autograder.core.errors import GraderError
 from autograder.core.exercise import Limits
 from autograder.sandbox import runner
 from autograder.sandbox.cgroups import Cgroup
+from autograder.sandbox.privileged import PACKAGE_PARENT, SAFE_CWD, module_command
+from autograder.sandbox.sweep import is_student_uid, sweep_user
 
 _PASS_THROUGH = (
     "PATH", "LD_LIBRARY_PATH", "PYTHONPATH", "AMENT_PREFIX_PATH", "ROS_DISTRO", "ROS_VERSION",
@@ -90,13 +92,17 @@ def student_python() -> str:
 def reap_recorded(record: dict[str, Any]) -> None:
     """Kill a student process known only by its record in the raw report (``pid`` and
     ``cgroups``), from another process: its process group and everything in its cgroups;
-    then remove its folder in strict isolation (``workdir``), which the run that started it
+    then every process of its own user (``uid``, strict isolation), and remove its folder
+    (``workdir``, strict isolation), which the run that started it
     removes when it stops the program, but not when the run itself is killed."""
     with contextlib.suppress(ProcessLookupError, PermissionError):
         os.killpg(record["pid"], signal.SIGKILL)
     group = Cgroup.existing(record.get("cgroups", []))
     group.kill_all()
     group.remove()
+    uid = record.get("uid")
+    if isinstance(uid, int) and is_student_uid(uid):
+        sweep_user(uid)
     workdir = record.get("workdir")
     if isinstance(workdir, str) and is_strict_workdir(Path(workdir)):
         shutil.rmtree(workdir, ignore_errors=True)
@@ -154,7 +160,7 @@ def warm_start(python: str, env: dict[str, str]) -> Any:
             if not _zygotes:
                 atexit.register(close_zygotes)
             try:
-                zygote = _zygotes[key] = Zygote(python, env, "/")
+                zygote = _zygotes[key] = Zygote(python, env, SAFE_CWD)
             except ZygoteGone:
                 _zygotes_failed.add(key)
                 return None
@@ -179,6 +185,20 @@ def forked_peak_mb() -> float:
     and reaped (what ``RUSAGE_CHILDREN`` tells of the programs it exec'd itself)."""
     with _zygotes_lock:
         return max((z.peak_kb for z in _zygotes.values()), default=0) / 1024
+
+
+# The programs of each student user this process has started and not reaped (by id): a
+# user's processes are swept once the last of its programs here is reaped.
+_users: dict[int, set[int]] = {}
+_users_lock = threading.Lock()
+
+
+def _user_done(process: StudentProcess) -> bool:
+    """Forget ``process``; whether no other program of its user is left in this process."""
+    with _users_lock:
+        mine = _users.get(process.uid, set())  # type: ignore[arg-type]
+        mine.discard(id(process))
+        return not mine
 
 
 class LaunchFailed(GraderError):
@@ -275,16 +295,20 @@ class StudentProcess:
         (self.workdir / ".ros" / "log").mkdir(parents=True, exist_ok=True)
         self.cgroup = Cgroup(f"run-{os.getpid()}-{uuid.uuid4().hex[:8]}", self.limits)
         spec: dict[str, object] = {"limits": dataclasses.asdict(self.limits),
-                                   "cgroups": [str(p) for p in self.cgroup.paths]}
+                                   "cgroups": [str(p) for p in self.cgroup.paths],
+                                   "workdir": str(self.workdir)}
         if self.uid is not None:
             spec.update(uid=self.uid, hide=[str(p) for p in self.hide],
-                        workdir=str(self.workdir), workdir_mb=self.workdir_mb)
+                        workdir_mb=self.workdir_mb)
         args = ["--ros-args", *self.ros_args]
         self.output = _Output(self.limits.output_kb * 1024)
         launcher_env = dict(self.env)
         launcher_env["PYTHONPATH"] = os.pathsep.join(
-            p for p in (str(Path(__file__).resolve().parents[2]), self.env.get("PYTHONPATH"))
+            p for p in (PACKAGE_PARENT, self.env.get("PYTHONPATH"))
             if p)
+        if self.uid is not None:
+            with _users_lock:
+                _users.setdefault(self.uid, set()).add(id(self))
         started = self._fork(spec, args, launcher_env) or self._exec(spec, args, launcher_env)
         self.popen, status_read = started
         self.started_at = time.monotonic()
@@ -325,11 +349,11 @@ class StudentProcess:
         """The program started through the launcher, which execs it once contained."""
         status_read, status_write = os.pipe()
         spec = {**spec, "status_fd": status_write}
-        command = [sys.executable, "-m", "autograder.sandbox.launcher", json.dumps(spec), "--",
-                   *runner.command(student_python(), str(self.script), args)]
+        command = module_command("autograder.sandbox.launcher", [
+            json.dumps(spec), "--", *runner.command(student_python(), str(self.script), args)])
         try:
             popen = subprocess.Popen(
-                command, cwd=self.workdir, env=env, stdin=subprocess.DEVNULL,
+                command, cwd=SAFE_CWD, env=env, stdin=subprocess.DEVNULL,
                 stdout=subprocess.PIPE, stderr=subprocess.STDOUT, start_new_session=True,
                 pass_fds=(status_write,))
         except BaseException:
@@ -407,6 +431,8 @@ class StudentProcess:
         if self.cgroup is not None:
             self.cgroup.kill_all()
             self.cgroup.remove()
+        if self.uid is not None and _user_done(self):
+            sweep_user(self.uid)  # what left the group and the cgroup, or had no cgroup
         if self._reader is not None:
             self._reader.join(2.0)
 

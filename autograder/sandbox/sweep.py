@@ -1,0 +1,142 @@
+"""End everything of a student's user once its programs are done: the processes that
+left their process group and cgroup (or ran where no cgroup could be made), and the SysV
+IPC objects, POSIX message queues and files in the shared scratch folders it made.
+
+Only for a user of the student's own (strict isolation gives each run one): never root,
+never the grader's user.  The kill is sent *as* that user, ``kill(-1, SIGKILL)``, which
+the kernel delivers to every process the sender may signal (all of that user's, itself
+excepted) in one pass, so a program forking as fast as it can is not raced pid by pid.
+In strict isolation the program's IPC objects and ``/tmp`` are its own namespace's and go
+with it; the sweep is for where there is no namespace to take them.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import ctypes
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+
+_KILL_ALL = "import os, signal; os.kill(-1, signal.SIGKILL)"
+
+STUDENT_UID_BASE = 200_000
+"""Strict isolation runs a student as ``STUDENT_UID_BASE + domain``, a user of its own."""
+ROS_DOMAINS = 233  # ROS domain ids 0..232: Fast DDS's ports end there
+
+
+def is_student_uid(uid: int) -> bool:
+    """Whether ``uid`` is one of the students' own users (the only ones swept)."""
+    return STUDENT_UID_BASE <= uid < STUDENT_UID_BASE + ROS_DOMAINS
+
+
+def user_processes(uid: int, proc: str = "/proc") -> list[int]:
+    """The live processes (not zombies) whose real user is ``uid``."""
+    found = []
+    for name in os.listdir(proc):
+        if not name.isdigit():
+            continue
+        try:
+            with open(f"{proc}/{name}/status", "rb") as fh:
+                fields = dict(line.split(b":", 1) for line in fh if b":" in line)
+            if int(fields[b"Uid"].split()[0]) == uid and not fields[b"State"].strip(
+                    ).startswith(b"Z"):
+                found.append(int(name))
+        except (OSError, KeyError, ValueError, IndexError):
+            continue  # gone meanwhile
+    return found
+
+
+def kill_user(uid: int, timeout: float = 5.0) -> bool:
+    """SIGKILL every process of ``uid`` until none is left (or ``timeout`` wall seconds
+    pass); whether none is left."""
+    if not is_student_uid(uid) or uid in (os.getuid(), os.geteuid()):
+        raise ValueError(f"will not sweep uid {uid}: not a student's own user")
+    deadline = time.monotonic() + timeout
+    setpriv = shutil.which("setpriv")
+    while True:
+        pids = user_processes(uid)
+        if not pids:
+            return True
+        if time.monotonic() > deadline:
+            return False
+        if setpriv is not None:
+            subprocess.run([setpriv, f"--reuid={uid}", f"--regid={uid}", "--clear-groups",
+                            sys.executable, "-I", "-S", "-c", _KILL_ALL], cwd="/",
+                           stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                           stderr=subprocess.DEVNULL, env={}, check=False)
+        else:  # pid by pid: the run's RLIMIT_NPROC bounds how many there can be
+            for pid in pids:
+                try:
+                    os.kill(pid, signal.SIGKILL)
+                except ProcessLookupError:
+                    pass
+        time.sleep(0.01)
+
+
+# The machine's shared scratch folders, where a program without a mount namespace of its
+# own can leave files (POSIX shared memory is files in /dev/shm; queues in /dev/mqueue).
+SCRATCH = ("/tmp", "/var/tmp", "/dev/shm", "/dev/mqueue")
+IPC_RMID = 0
+# /proc/sysvipc/<kind>: the column of the id and of the owner, and how to remove one.
+_SYSV = {"shm": ("shmid", "uid", "shmctl"), "msg": ("msqid", "uid", "msgctl"),
+         "sem": ("semid", "uid", "semctl")}
+
+
+def user_ipc(uid: int, proc: str = "/proc") -> list[tuple[str, int]]:
+    """The SysV IPC objects (kind, id) owned or created by ``uid``, in this namespace."""
+    found = []
+    for kind, (id_column, _owner, _remove) in _SYSV.items():
+        try:
+            with open(f"{proc}/sysvipc/{kind}") as fh:
+                header, *rows = [line.split() for line in fh]
+        except OSError:
+            continue
+        for row in rows:
+            fields = dict(zip(header, row, strict=False))
+            with contextlib.suppress(KeyError, ValueError):
+                if uid in (int(fields["uid"]), int(fields["cuid"])):
+                    found.append((kind, int(fields[id_column])))
+    return found
+
+
+def remove_user_ipc(uid: int) -> None:
+    """Remove every SysV IPC object of ``uid`` (a segment still attached goes once
+    detached: its last user is dead by now)."""
+    libc = ctypes.CDLL(None, use_errno=True)
+    for kind, ident in user_ipc(uid):
+        remove = getattr(libc, _SYSV[kind][2])
+        if kind == "sem":
+            remove(ident, 0, IPC_RMID)
+        else:
+            remove(ident, IPC_RMID, None)
+
+
+def remove_user_files(uid: int, folders: tuple[str, ...] = SCRATCH) -> None:
+    """Remove what ``uid`` owns at the top of each scratch folder (a folder with all in it;
+    links themselves, never what they point to)."""
+    for folder in folders:
+        try:
+            entries = list(os.scandir(folder))
+        except OSError:
+            continue
+        for entry in entries:
+            with contextlib.suppress(OSError):
+                if entry.stat(follow_symlinks=False).st_uid != uid:
+                    continue
+                if entry.is_dir(follow_symlinks=False):
+                    shutil.rmtree(entry.path, ignore_errors=True)  # fd-based: no link races
+                else:
+                    os.unlink(entry.path)
+
+
+def sweep_user(uid: int) -> bool:
+    """End every process of the student's ``uid``, then remove its IPC objects and scratch
+    files; whether no process was left."""
+    gone = kill_user(uid)
+    remove_user_ipc(uid)
+    remove_user_files(uid)
+    return gone
