@@ -97,32 +97,35 @@ def test_hierarchy_is_detected_under_the_root_read_at_each_call(
     assert cgroup_root() == Path("/sys/fs/cgroup")
 
 
-def test_v2_enables_pids_and_memory_and_sets_the_leaf_limits(v2_root: Path) -> None:
+def test_v2_enables_pids_memory_and_cpu_and_sets_the_leaf_limits(v2_root: Path) -> None:
     group = Cgroup("run-a", LIMITS)
     leaf = v2_root / "autograder" / "run-a"
     assert group.paths == [leaf]
     assert group.version == "v2"
-    assert group.controllers == {"pids", "memory"}
-    assert (v2_root / "cgroup.subtree_control").read_text() == "+pids +memory"
-    assert (v2_root / "autograder" / "cgroup.subtree_control").read_text() == "+pids +memory"
+    assert group.controllers == {"pids", "memory", "cpu"}
+    enabled = "+pids +memory +cpu"
+    assert (v2_root / "cgroup.subtree_control").read_text() == enabled
+    assert (v2_root / "autograder" / "cgroup.subtree_control").read_text() == enabled
     assert (leaf / "pids.max").read_text() == "32"
     assert (leaf / "memory.max").read_text() == MEMORY_BYTES
+    assert (leaf / "cpu.weight").read_text() == "100"  # a share of its own, the default
     assert not (leaf / "memory.limit_in_bytes").exists()
     info = json.loads(json.dumps(group.info()))
-    assert info == {"version": "v2", "controllers": ["memory", "pids"], "paths": [str(leaf)]}
+    assert info == {"version": "v2", "controllers": ["cpu", "memory", "pids"],
+                    "paths": [str(leaf)]}
     assert group.bounds(separate_uid=False) == {
-        "cgroup": "v2", "processes": "cgroup", "memory": "cgroup"}
+        "cgroup": "v2", "processes": "cgroup", "memory": "cgroup", "cpu": "cgroup"}
 
 
 def test_v2_leaves_an_already_enabled_subtree_control_alone(v2_root: Path) -> None:
     (v2_root / "cgroup.subtree_control").write_text("cpu memory pids\n")
     group = Cgroup("run-a", LIMITS)
     assert (v2_root / "cgroup.subtree_control").read_text() == "cpu memory pids\n"
-    assert group.controllers == {"pids", "memory"}
+    assert group.controllers == {"pids", "memory", "cpu"}
 
 
 def test_v2_controller_the_root_does_not_offer_is_unavailable(v2_root: Path) -> None:
-    (v2_root / "cgroup.controllers").write_text("cpu memory\n")
+    (v2_root / "cgroup.controllers").write_text("io memory\n")
     group = Cgroup("run-a", LIMITS)
     leaf = v2_root / "autograder" / "run-a"
     assert group.controllers == {"memory"}
@@ -132,7 +135,7 @@ def test_v2_controller_the_root_does_not_offer_is_unavailable(v2_root: Path) -> 
     assert (leaf / "memory.max").read_text() == MEMORY_BYTES
     assert group.bounds(separate_uid=False)["processes"] is None
     assert group.bounds(separate_uid=True) == {
-        "cgroup": "v2", "processes": "rlimit", "memory": "cgroup"}
+        "cgroup": "v2", "processes": "rlimit", "memory": "cgroup", "cpu": None}
 
 
 def test_v2_refused_subtree_control_keeps_the_leaf_without_limits(v2_root: Path) -> None:
@@ -144,7 +147,7 @@ def test_v2_refused_subtree_control_keeps_the_leaf_without_limits(v2_root: Path)
     assert group.controllers == set()
     assert not (leaf / "pids.max").exists() and not (leaf / "memory.max").exists()
     assert group.bounds(separate_uid=True) == {
-        "cgroup": "v2", "processes": "rlimit", "memory": "rlimit"}
+        "cgroup": "v2", "processes": "rlimit", "memory": "rlimit", "cpu": None}
 
 
 def test_v2_a_refused_controller_does_not_cost_the_other(
@@ -159,8 +162,9 @@ def test_v2_a_refused_controller_does_not_cost_the_other(
     monkeypatch.setattr(cgroups, "_write", refuse_memory)
     group = Cgroup("run-a", LIMITS)
     leaf = v2_root / "autograder" / "run-a"
-    assert group.controllers == {"pids"}
-    assert (v2_root / "cgroup.subtree_control").read_text() == "+pids"
+    assert group.controllers == {"pids", "cpu"}
+    # (the fake file keeps only the last of the one-at-a-time writes)
+    assert "memory" not in (v2_root / "cgroup.subtree_control").read_text()
     assert (leaf / "pids.max").read_text() == "32"
     assert not (leaf / "memory.max").exists()
 
@@ -171,7 +175,7 @@ def test_v2_nothing_writable_creates_nothing(v2_root: Path) -> None:
     assert not group.available and group.version is None
     assert (v2_root / "cgroup.subtree_control").read_text() == ""
     assert group.bounds(separate_uid=False) == {
-        "cgroup": None, "processes": None, "memory": "rlimit"}
+        "cgroup": None, "processes": None, "memory": "rlimit", "cpu": None}
 
 
 def test_v2_kill_all_writes_cgroup_kill_and_kills_the_members(
@@ -201,7 +205,7 @@ def test_v2_existing_knows_its_version_and_reaps(
     child = _join(Cgroup("run-a", LIMITS), children)
     group = Cgroup.existing([str(leaf)])
     assert group.version == "v2"
-    assert group.controllers == {"pids", "memory"}
+    assert group.controllers == {"pids", "memory", "cpu"}
     assert group.kill_all()
     assert (leaf / "cgroup.kill").read_text() == "1"
     _assert_killed(child)
@@ -238,20 +242,32 @@ def test_v1_unmounted_controller_is_not_created(v1_root: Path) -> None:
     assert group.controllers == {"pids"}
     assert not (v1_root / "memory").exists()
     assert group.bounds(separate_uid=False) == {
-        "cgroup": "v1", "processes": "cgroup", "memory": "rlimit"}
+        "cgroup": "v1", "processes": "cgroup", "memory": "rlimit", "cpu": None}
+
+
+def test_v1_cpu_group_sits_at_the_top_of_its_hierarchy(v1_root: Path) -> None:
+    """A share of its own beside the grader's processes, not one shared by all students."""
+    (v1_root / "cpu").mkdir()
+    group = Cgroup("run-a", LIMITS)
+    cpu = v1_root / "cpu" / "autograder-run-a"
+    assert cpu in group.paths and group.controllers == {"pids", "memory", "cpu"}
+    assert (cpu / "cpu.shares").read_text() == "1024"
+    assert not (v1_root / "cpu" / "autograder").exists()
+    assert Cgroup.existing(map(str, group.paths)).controllers == {"pids", "memory", "cpu"}
+    assert group.bounds(separate_uid=True)["cpu"] == "cgroup"
 
 
 @pytest.mark.parametrize(("info", "separate_uid", "expected"), [
-    (None, True, {"cgroup": None, "processes": "rlimit", "memory": "rlimit"}),
-    (None, False, {"cgroup": None, "processes": None, "memory": "rlimit"}),
+    (None, True, {"cgroup": None, "processes": "rlimit", "memory": "rlimit", "cpu": None}),
+    (None, False, {"cgroup": None, "processes": None, "memory": "rlimit", "cpu": None}),
     ({"version": None, "controllers": [], "paths": []}, False,
-     {"cgroup": None, "processes": None, "memory": "rlimit"}),
-    ({"version": "v2", "controllers": ["memory", "pids"], "paths": ["/x"]}, True,
-     {"cgroup": "v2", "processes": "cgroup", "memory": "cgroup"}),
+     {"cgroup": None, "processes": None, "memory": "rlimit", "cpu": None}),
+    ({"version": "v2", "controllers": ["cpu", "memory", "pids"], "paths": ["/x"]}, True,
+     {"cgroup": "v2", "processes": "cgroup", "memory": "cgroup", "cpu": "cgroup"}),
     ({"version": "v1", "controllers": ["memory"], "paths": ["/x"]}, True,
-     {"cgroup": "v1", "processes": "rlimit", "memory": "cgroup"}),
+     {"cgroup": "v1", "processes": "rlimit", "memory": "cgroup", "cpu": None}),
     ({"version": "v2", "controllers": [], "paths": ["/x"]}, False,
-     {"cgroup": "v2", "processes": None, "memory": "rlimit"}),
+     {"cgroup": "v2", "processes": None, "memory": "rlimit", "cpu": None}),
 ])
 def test_describe_bounds(info: dict[str, object] | None, separate_uid: bool,
                          expected: dict[str, str | None]) -> None:

@@ -232,3 +232,36 @@ def test_a_strict_programs_sysv_objects_are_its_own_namespaces(tmp_path):
     assert "SHM -1" not in process.output_text()  # it made one
     libc = ctypes.CDLL(None)
     assert libc.shmget(key, 0, 0) == -1  # and the machine has none under that key
+
+
+def test_a_program_and_what_it_forks_share_one_cpu_group_of_their_own(tmp_path):
+    """Where cpu cgroups can be made, the program and its children sit in one of their own,
+    so its spinning children take one share from the gradings beside it, not six."""
+    from autograder.sandbox.cgroups import Cgroup
+
+    probe = Cgroup(f"cpu-check-{os.getpid()}", Limits())
+    probe.remove()
+    if "cpu" not in probe.controllers:
+        pytest.skip("no writable cpu cgroup here")
+    staged = tmp_path / "staged"
+    staged.mkdir()
+    script = staged / "program.py"
+    script.write_text("import os\n"
+                      "pid = os.fork()\n"
+                      "if pid == 0:\n"
+                      "    print('CHILD', open('/proc/self/cgroup').read(), flush=True)\n"
+                      "    os._exit(0)\n"
+                      "os.waitpid(pid, 0)\n"
+                      "print('PARENT', open('/proc/self/cgroup').read(), flush=True)\n")
+    process = student_process(script, [], Limits(), domain=0, strict=False, course=COURSE)
+    process.start()
+    assert process.wait(30) == 0
+    cpu = [p for p in process.cgroup.paths if (p / "cpu.shares").exists()
+           or (p / "cpu.weight").exists()]
+    process.stop()
+    assert len(cpu) == 1
+    for who in ("CHILD", "PARENT"):
+        section = process.output_text().split(who, 1)[1]
+        lines = [line for line in section.splitlines()
+                 if ":cpu" in line or line.startswith("0::")]
+        assert any(line.endswith("/" + cpu[0].name) for line in lines), (who, lines)

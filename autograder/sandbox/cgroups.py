@@ -7,13 +7,17 @@ Where the groups live
     unified hierarchy), anything else is taken as **v1**.
 
 v1
-    One group per controller: ``<root>/pids/autograder/<name>`` (``pids.max``) and
-    ``<root>/memory/autograder/<name>`` (``memory.limit_in_bytes``).  The controller
+    One group per controller: ``<root>/pids/autograder/<name>`` (``pids.max``),
+    ``<root>/memory/autograder/<name>`` (``memory.limit_in_bytes``) and
+    ``<root>/cpu/autograder-<name>`` (``cpu.shares``, the default: a share of its own,
+    at the top of the hierarchy).  The controller
     folders must already be mounted; nothing here creates them.
 
 v2
-    One leaf per run, ``<root>/autograder/<name>``, with ``pids.max`` and ``memory.max``.
-    For those files to exist, ``pids`` and ``memory`` must be enabled in the
+    One leaf per run, ``<root>/autograder/<name>``, with ``pids.max``, ``memory.max`` and
+    ``cpu.weight`` (the default; the students together then weigh as much as the
+    ``autograder`` folder's siblings, the grader's own processes among them). For those
+    files to exist, the controllers must be enabled in the
     ``cgroup.subtree_control`` of ``<root>`` and of ``<root>/autograder``; they are
     enabled there when the root offers them (its ``cgroup.controllers``).  The kernel's
     "no internal processes" rule refuses that (EBUSY) in a non-root group that holds
@@ -25,7 +29,7 @@ Delegation (v2, for an instructor)
     The grader needs a cgroup2 folder it may write, holding none of its own processes, and
     ``AUTOGRADER_CGROUP_ROOT`` pointing at it.
 
-    * systemd: run the grader as a service with ``Delegate=pids memory`` (or ``yes``) and
+    * systemd: run the grader as a service with ``Delegate=pids memory cpu`` (or ``yes``) and
       ``DelegateSubgroup=supervisor`` (systemd 254+; it keeps the service's own processes
       in a child group), then set ``AUTOGRADER_CGROUP_ROOT`` to the service's folder, e.g.
       ``/sys/fs/cgroup/system.slice/autograder.service``.  A grader that is not root also
@@ -56,12 +60,17 @@ from typing import Any, Literal
 from autograder.core.exercise import Limits
 
 Version = Literal["v1", "v2"]
-CONTROLLERS = ("pids", "memory")
+# ``cpu`` sets no limit: a group of its own makes the program one entity for the CPU
+# scheduler whatever it forks, so a student's spinning children take one share, not one
+# per child, from the gradings running beside it (issue 28).
+CONTROLLERS = ("pids", "memory", "cpu")
 # The file that carries each controller's limit, per hierarchy.
 LIMIT_FILES: dict[Version, dict[str, str]] = {
-    "v1": {"pids": "pids.max", "memory": "memory.limit_in_bytes"},
-    "v2": {"pids": "pids.max", "memory": "memory.max"},
+    "v1": {"pids": "pids.max", "memory": "memory.limit_in_bytes", "cpu": "cpu.shares"},
+    "v2": {"pids": "pids.max", "memory": "memory.max", "cpu": "cpu.weight"},
 }
+# The default share of each hierarchy: every program the same.
+CPU_SHARE: dict[Version, str] = {"v1": "1024", "v2": "100"}
 PARENT = "autograder"
 
 
@@ -75,8 +84,17 @@ def hierarchy(root: Path) -> Version:
     return "v2" if (root / "cgroup.controllers").exists() else "v1"
 
 
-def _limit_values(limits: Limits) -> dict[str, str]:
-    return {"pids": str(limits.processes), "memory": str(limits.memory_mb * 1024 * 1024)}
+def _limit_values(limits: Limits, version: Version) -> dict[str, str]:
+    return {"pids": str(limits.processes), "memory": str(limits.memory_mb * 1024 * 1024),
+            "cpu": CPU_SHARE[version]}
+
+
+def _v1_folder(mount: Path, controller: str, name: str) -> Path:
+    """Where a run's v1 group of ``controller`` lives. ``cpu`` groups sit at the top of
+    their hierarchy, beside the grader's own processes: under a shared parent, every
+    student of every grading would weigh as one thread of the grader's, and a batch's
+    programs would starve (measured: a memory bomb too slow to reach its limit)."""
+    return mount / (f"{PARENT}-{name}" if controller == "cpu" else f"{PARENT}/{name}")
 
 
 def _write(path: Path, value: str) -> None:
@@ -123,12 +141,12 @@ def _enable(group: Path, wanted: set[str]) -> set[str]:
 def _create_v1(root: Path, name: str, limits: Limits) -> tuple[list[Path], set[str]]:
     paths: list[Path] = []
     controllers: set[str] = set()
-    values = _limit_values(limits)
+    values = _limit_values(limits, "v1")
     for controller in CONTROLLERS:
         mount = root / controller
         if not mount.is_dir():
             continue  # not mounted: creating the folder would make a plain directory
-        path = mount / PARENT / name
+        path = _v1_folder(mount, controller, name)
         try:
             path.mkdir(parents=True, exist_ok=True)
             _write(path / LIMIT_FILES["v1"][controller], values[controller])
@@ -153,7 +171,7 @@ def _create_v2(root: Path, name: str, limits: Limits) -> tuple[list[Path], set[s
         leaf.mkdir(exist_ok=True)
     except OSError:
         return [], set()
-    values = _limit_values(limits)
+    values = _limit_values(limits, "v2")
     # A leaf without controllers is still kept: it holds every process the student starts,
     # so cgroup.kill and cgroup.procs reach daemons that left the session.
     controllers = {c for c in usable
@@ -188,7 +206,7 @@ class Cgroup:
     ``paths`` are the folders a process joins (by writing its pid to ``cgroup.procs``):
     one per controller on v1, one leaf on v2, none where nothing was writable.
     ``version`` is ``"v1"``, ``"v2"`` or None (no group); ``controllers`` are the ones
-    whose limit was set (``pids``, ``memory``).
+    whose limit or share was set (``pids``, ``memory``, ``cpu``).
     """
 
     def __init__(self, name: str, limits: Limits) -> None:
@@ -274,10 +292,12 @@ def describe_bounds(cgroup_info: Mapping[str, Any] | None,
 
         {"cgroup": "v2" | "v1" | None,         # the hierarchy the program ran in
          "processes": "cgroup" | "rlimit" | None,
-         "memory": "cgroup" | "rlimit"}        # RLIMIT_AS always applies besides
+         "memory": "cgroup" | "rlimit",        # RLIMIT_AS always applies besides
+         "cpu": "cgroup" | None}               # a CPU share of its own
     """
     info = cgroup_info or {}
     controllers = set(info.get("controllers", ()))
     processes = "cgroup" if "pids" in controllers else "rlimit" if separate_uid else None
     memory = "cgroup" if "memory" in controllers else "rlimit"
-    return {"cgroup": info.get("version"), "processes": processes, "memory": memory}
+    return {"cgroup": info.get("version"), "processes": processes, "memory": memory,
+            "cpu": "cgroup" if "cpu" in controllers else None}
