@@ -23,11 +23,11 @@ ticks per wall second, holding for a busy student process, the start-up hold) is
 by :class:`sim.pacing.Pacer`; the bridge only steps the world and publishes.
 ``effective_rtf`` reports the measured sim seconds per wall second of the last ticks.
 
-Physics runs in one thread and an executor (for the node's parameter services) in
-another; the world is only touched under the bridge's lock (the pacer's condition), and
-waiters are woken on it each tick.  Taps (:meth:`SimBridge.add_tap`, e.g. a
-:class:`sim.bag.BagRecorder`) see every message the bridge publishes or receives, with its
-simulation time.
+Physics runs in one thread and an executor in another (the node serves no parameter
+services: another node must not set its ``use_sim_time``); the world is only touched
+under the bridge's lock (the pacer's condition), and waiters are woken on it each tick.
+Taps (:meth:`SimBridge.add_tap`, e.g. a :class:`sim.bag.BagRecorder`) see every message
+the bridge publishes or receives, with its simulation time.
 """
 
 from __future__ import annotations
@@ -119,7 +119,8 @@ class SimBridge:
         # those made so far as (sim time, rtf).
         self._pace_due: list[tuple[float, float]] = []
         self.pace_changes: list[tuple[float, float]] = []
-        self.node = Node(node_name, context=context)
+        # No parameter services: no other node may change the world's (use_sim_time).
+        self.node = Node(node_name, context=context, start_parameter_services=False)
         qos = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
         self._clock_pub = self.node.create_publisher(Clock, "/clock", qos)
         self._odom_pub = self.node.create_publisher(Odometry, "/odom", qos)

@@ -122,7 +122,9 @@ class Probe:
 
     def __init__(self, context: Context, world: Any, name: str = PROBE_NODE_NAME) -> None:
         self.world = world
-        self.node = Node(name, context=context,
+        # No parameter services: a student's program must not change the grader's
+        # parameters (use_sim_time); ours are set here, in-process.
+        self.node = Node(name, context=context, start_parameter_services=False,
                          parameter_overrides=[Parameter("use_sim_time", value=True)])
         self._executor = SingleThreadedExecutor(context=context)
         self._executor.add_node(self.node)
