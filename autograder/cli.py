@@ -478,13 +478,19 @@ def gradebook_merge(out: Path, inputs: tuple[Path, ...]) -> None:
 @click.option("--platform-repo", default="https://github.com/COURSE/rclpy-autograder-release",
               show_default=True, help="Git URL pip installs the platform from.")
 @click.option("--hidden-repo", default="COURSE/rclpy-hidden-tests", show_default=True,
-              help="Private repository holding the course tree with hidden tests.")
+              help="Private repository holding the course tree with hidden tests "
+                   "(github-shards, k8s-shards).")
 @click.option("--claim", default="grading-data", show_default=True,
               help="Kubernetes volume claim with submissions/ and out/.")
 def workflow(kind: str, exercise: str, submission: str, shards: int, platform_repo: str,
              hidden_repo: str, claim: str) -> None:
     """Print a CI workflow: a student repository's grade-on-push (github-student), or a
-    course's sharded batch grading (github-shards, k8s-shards)."""
+    course's sharded batch grading (github-shards, k8s-shards).
+
+    github-student runs the public tests only and names no secret: students can edit their
+    repository's workflows. Hidden tests run in the course's private repository
+    (github-shards, which pulls in the submissions), on Gradescope or on Kubernetes
+    (k8s-shards)."""
     from autograder.commands.workflows import render_workflow
 
     click.echo(render_workflow(kind, exercise=exercise, submission=submission, shards=shards,

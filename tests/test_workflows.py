@@ -1,4 +1,7 @@
-"""The CI templates render to valid YAML that runs our commands."""
+"""The CI templates render to valid YAML that runs our commands, and a student's
+repository's workflow names no secret."""
+
+from typing import Any
 
 import yaml
 from click.testing import CliRunner
@@ -11,31 +14,56 @@ VALUES = {"exercise": "timer_sync", "submission": "src", "shards": 5,
           "claim": "data"}
 
 
-def test_student_workflow_runs_public_and_hidden_tests():
-    text = render_workflow("github-student", **VALUES)
-    flow = yaml.safe_load(text)
-    steps = flow["jobs"]["grade"]["steps"]
-    runs = " ".join(s.get("run", "") for s in steps)
-    assert "autograder check timer_sync src" in runs
-    assert "autograder grade timer_sync src" in runs
-    assert "${{ secrets.HIDDEN_TESTS_TOKEN }}" in text
-    assert any(s.get("with", {}).get("repository") == "course/hidden" for s in steps)
+def runs(steps: list[dict[str, Any]]) -> str:
+    return " ".join(s.get("run", "") for s in steps)
 
+
+# --- a student's repository --------------------------------------------------------------
+
+def test_student_workflow_runs_the_public_tests_and_names_no_secret():
+    text = render_workflow("github-student", **VALUES)
+    assert "secrets." not in text and "token" not in text.lower()
+    assert VALUES["hidden_repo"] not in text
+    flow = yaml.safe_load(text)
+    assert flow["permissions"] == {"contents": "read"}
+    steps = flow["jobs"]["grade"]["steps"]
+    assert "autograder check timer_sync src" in runs(steps)
+    assert "autograder grade " not in runs(steps)
+    checkouts = [s for s in steps if s.get("uses", "").startswith("actions/checkout")]
+    assert [c["with"] for c in checkouts] == [{"persist-credentials": False}]
+    assert not any("env" in s for s in steps)
+
+
+def test_the_hidden_repo_option_does_not_reach_the_student_workflow():
+    plain = CliRunner().invoke(main, ["workflow", "github-student"])
+    named = CliRunner().invoke(main, ["workflow", "github-student",
+                                      "--hidden-repo", "course/secret-tests"])
+    assert plain.exit_code == named.exit_code == 0
+    assert plain.output == named.output
+
+
+def test_workflow_help_says_where_hidden_tests_run():
+    text = " ".join(CliRunner().invoke(main, ["workflow", "--help"]).output.split())
+    assert "public tests only" in text
+    assert "github-shards" in text and "Gradescope" in text and "k8s-shards" in text
+
+
+# --- the course's repository -------------------------------------------------------------
 
 def test_github_matrix_shards_and_merges():
     flow = yaml.safe_load(render_workflow("github-shards", **VALUES))
     assert flow["jobs"]["shard"]["strategy"]["matrix"]["shard"] == [1, 2, 3, 4, 5]
-    shard_runs = " ".join(s.get("run", "") for s in flow["jobs"]["shard"]["steps"])
-    assert "--shard ${{ matrix.shard }}/5" in shard_runs
+    assert "--shard ${{ matrix.shard }}/5" in runs(flow["jobs"]["shard"]["steps"])
     course = next(s for s in flow["jobs"]["shard"]["steps"]
                   if s.get("with", {}).get("repository") == "course/hidden")
     assert course["with"]["path"] == "course"
     grading = next(s for s in flow["jobs"]["shard"]["steps"] if "grade-batch" in s.get("run", ""))
     assert grading["env"]["AUTOGRADER_COURSE"] == "${{ github.workspace }}/course"
-    merge_runs = " ".join(s.get("run", "") for s in flow["jobs"]["merge"]["steps"])
-    assert "autograder gradebook merge gradebook.csv" in merge_runs
+    assert "autograder gradebook merge gradebook.csv" in runs(flow["jobs"]["merge"]["steps"])
     assert flow["jobs"]["merge"]["needs"] == "shard"
 
+
+# --- Kubernetes -------------------------------------------------------------------------
 
 def test_kubernetes_indexed_job_and_merge_job():
     job, merge = yaml.safe_load_all(render_workflow("k8s-shards", **VALUES))
