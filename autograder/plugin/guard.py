@@ -1,10 +1,19 @@
 """The tampering guard: a test during which the student's program impersonated the world
-or the grader on the graph is failed, not rewarded."""
+or the grader on the graph is failed, not rewarded.
+
+A :class:`GraphWatch` looks at the probe's graph every ``WATCH_EVERY`` wall seconds, from
+a thread of its own, for as long as the module's probe lives, and keeps when it saw each
+finding.  A test is charged with all that was seen since the previous test ended (the
+first test: since the probe started), so a foreign publisher that lives a fraction of a
+second inside a test fails that test, and one seen between two tests fails the next.
+"""
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-from typing import TYPE_CHECKING
+import threading
+import time
+from collections.abc import Callable, Iterator
+from typing import TYPE_CHECKING, Any
 
 import pytest
 
@@ -18,22 +27,136 @@ if TYPE_CHECKING:
 
 # Topics only the world publishes.
 WORLD_TOPICS = ("/clock", "/odom", "/scan")
+# Wall seconds between two looks: a publisher that lives 0.3 s is seen about ten times.
+WATCH_EVERY = 0.025
+
+# A finding: ("publishes", node, topic) or ("named", name, "").
+Finding = tuple[str, str, str]
+
+
+def _publishing(node: Any) -> list[Finding]:
+    """Nodes other than the grader's that publish on the world's topics."""
+    return [("publishes", info.node_name, topic) for topic in WORLD_TOPICS
+            for info in node.get_publishers_info_by_topic(topic)
+            if info.node_name not in GRADER_NODES]
+
+
+def _named_twice(node: Any) -> list[Finding]:
+    """The grader's names that a second node carries."""
+    names = [name for name, _ns in node.get_node_names_and_namespaces()]
+    return [("named", name, "") for name in GRADER_NODES if names.count(name) > 1]
+
+
+def _describe(finding: Finding) -> str:
+    kind, node, topic = finding
+    if kind == "publishes":
+        return _("node '{node}' publishes on {topic}, which the simulator owns").format(
+            node=node, topic=topic)
+    return _("a second node is named '{name}', the grader's name").format(name=node)
 
 
 def tampering(probe: Probe) -> list[str]:
     """What on the graph impersonates the world or the grader, in plain words."""
-    found = []
-    for topic in WORLD_TOPICS:
-        for info in probe.node.get_publishers_info_by_topic(topic):
-            if info.node_name not in GRADER_NODES:
-                found.append(_("node '{node}' publishes on {topic}, which the simulator "
-                               "owns").format(node=info.node_name, topic=topic))
-    names = [name for name, _ns in probe.node.get_node_names_and_namespaces()]
-    for name in GRADER_NODES:
-        if names.count(name) > 1:
-            found.append(_("a second node is named '{name}', the grader's name").format(
-                name=name))
-    return found
+    return [_describe(f) for f in _publishing(probe.node) + _named_twice(probe.node)]
+
+
+class GraphWatch:
+    """Looks at ``probe``'s graph every ``every`` wall seconds (:meth:`start` to
+    :meth:`stop`) and keeps, for each finding, the spans of time it was seen in."""
+
+    def __init__(self, probe: Probe, every: float = WATCH_EVERY,
+                 clock: Callable[[], float] = time.monotonic) -> None:
+        self._probe = probe
+        self._every = every
+        self._clock = clock
+        self._lock = threading.Lock()
+        self._looking = threading.Lock()  # one look at a time: the thread's or a charge's
+        # finding -> [first, last] seen, one span per run of consecutive looks
+        self._spans: dict[Finding, list[list[float]]] = {}
+        self._last: set[Finding] = set()
+        # Publisher counts on WORLD_TOPICS when a look found them all the grader's.
+        self._clean: list[int] | None = None
+        self._charged = clock()  # what was seen before this was charged to a test
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+
+    def start(self) -> None:
+        """Look now and then every ``every`` seconds, from a daemon thread."""
+        self._thread = threading.Thread(target=self._run, daemon=True, name="graph-watch")
+        self._thread.start()
+
+    def stop(self) -> None:
+        """No more looks (call before the probe's node goes); what was seen stays."""
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join()
+            self._thread = None
+
+    def _run(self) -> None:
+        due = self._clock()
+        while not self._stop.is_set():
+            try:
+                self.look()
+            except Exception:
+                if self._stop.is_set():  # the node went while we looked
+                    return
+                raise
+            due = max(due + self._every, self._clock())  # a slow look skips, never bunches
+            self._stop.wait(due - self._clock())
+
+    def look(self) -> None:
+        """Look at the graph once and note the time of what is there."""
+        with self._looking:
+            found = set(self._publishing() + _named_twice(self._probe.node))
+            with self._lock:  # stamped under the lock: a look is before or after a charge
+                now = self._clock()
+                for finding in found:
+                    spans = self._spans.setdefault(finding, [])
+                    if finding in self._last and spans:
+                        spans[-1][1] = now
+                    else:
+                        spans.append([now, now])
+                self._last = found
+
+    def _publishing(self) -> list[Finding]:
+        """:func:`_publishing`, read only when the publisher counts changed since a look
+        that found all of them the grader's: the grader's own stay while its probe lives,
+        so the same counts are the same publishers (counting costs a fifth of reading)."""
+        node = self._probe.node
+        counts = [node.count_publishers(topic) for topic in WORLD_TOPICS]
+        if counts == self._clean:
+            return []
+        found = _publishing(node)
+        self._clean = None if found else counts
+        return found
+
+    @property
+    def seen(self) -> dict[Finding, list[tuple[float, float]]]:
+        """Every finding with the (first, last) times of each span it was seen in."""
+        with self._lock:
+            return {f: [(a, b) for a, b in spans] for f, spans in self._spans.items()}
+
+    def charge(self) -> list[str]:
+        """After a look, what was seen since the last charge (or the start), in words, in
+        the order first seen; later charges start from now."""
+        self.look()
+        with self._lock:
+            since, self._charged = self._charged, self._clock()
+            due = [(min(a for a, b in spans if b >= since), f)
+                   for f, spans in self._spans.items() if any(b >= since for _a, b in spans)]
+        return [_describe(f) for _first, f in sorted(due)]
+
+
+# On a test module: the watch started with its probe (plugin/world.py).
+graph_watch_key = pytest.StashKey[GraphWatch]()
+
+
+def _module_watch(item: pytest.Item) -> GraphWatch | None:
+    for node in reversed(item.listchain()):
+        watch = node.stash.get(graph_watch_key, None)
+        if watch is not None:
+            return watch
+    return None
 
 
 @pytest.fixture(autouse=True)
@@ -43,9 +166,17 @@ def _graph_guard(request: pytest.FixtureRequest) -> Iterator[None]:
         yield
         return
     probe = request.getfixturevalue("probe")
-    before = tampering(probe)
-    yield
-    seen = before + [t for t in tampering(probe) if t not in before]
+    watch = _module_watch(request.node)
+    own = watch is None
+    if watch is None:  # a probe the module made itself: watch it for this test
+        watch = GraphWatch(probe)
+        watch.start()
+    try:
+        yield
+        seen = watch.charge()
+    finally:
+        if own:
+            watch.stop()
     if seen:
         raise StudentFailure(
             _("Tampering with the simulated world: {what}. Tests run while it happens are "

@@ -13,6 +13,7 @@ import pytest
 
 from autograder.core.errors import StudentFailure
 from autograder.plugin.bag import attach_probe, close_bag, open_bag
+from autograder.plugin.guard import GraphWatch, graph_watch_key
 from autograder.plugin.probe import WORLD_NODE_NAME
 from autograder.plugin.stash import reporter_key, settings_key, type_watch_key
 from autograder.plugin.timing import Timing
@@ -64,7 +65,7 @@ def ros_context(pytestconfig: pytest.Config) -> Iterator[Context]:
     settings = pytestconfig.stash[settings_key]
     if settings.strict:
         bring_up_loopback()  # the run's own network namespace starts with lo down
-    for key, value in dds_env(Isolation(settings.strict)).items():
+    for key, value in dds_env(Isolation(settings.isolation)).items():
         if value is None:
             os.environ.pop(key, None)
         else:
@@ -148,8 +149,13 @@ def probe(request: pytest.FixtureRequest, ros_context: Context,
         attach_probe(request, node)
     # For the reporter: what the graph showed of types that never match (msgtypes.py).
     request.node.stash[type_watch_key] = node.types
+    # For the tampering guard: the graph, watched from now until the probe goes.
+    watch = GraphWatch(node)
+    watch.start()
+    request.node.stash[graph_watch_key] = watch
     try:
         yield node
     finally:
+        watch.stop()
         with timing.phase(request.node.nodeid, "world_start"):
             node.close()
