@@ -1,6 +1,10 @@
-"""The CI templates render to valid YAML that runs our commands, and a student's
-repository's workflow names no secret."""
+"""The CI templates render to valid YAML that runs our commands, and keep secrets where
+students' programs are not: none in a student's repository, a token only in the step that
+fetches the course."""
 
+import os
+import subprocess
+from pathlib import Path
 from typing import Any
 
 import yaml
@@ -61,6 +65,44 @@ def test_github_matrix_shards_and_merges():
     assert grading["env"]["AUTOGRADER_COURSE"] == "${{ github.workspace }}/course"
     assert "autograder gradebook merge gradebook.csv" in runs(flow["jobs"]["merge"]["steps"])
     assert flow["jobs"]["merge"]["needs"] == "shard"
+
+
+def test_github_shards_token_only_in_the_fetch_before_grading():
+    text = render_workflow("github-shards", **VALUES)
+    flow = yaml.safe_load(text)
+    assert flow["permissions"] == {"contents": "read"}
+    steps = flow["jobs"]["shard"]["steps"]
+    naming = [i for i, s in enumerate(steps) if "secrets." in yaml.safe_dump(s)]
+    assert text.count("secrets.") == 1 and len(naming) == 1
+    fetch = steps[naming[0]]
+    assert fetch["with"]["token"] == "${{ secrets.HIDDEN_TESTS_TOKEN }}"
+    assert fetch["with"]["repository"] == VALUES["hidden_repo"]
+    grading = next(i for i, s in enumerate(steps) if "grade-batch" in s.get("run", ""))
+    assert naming[0] < grading
+    assert set(steps[grading]["env"]) == {"AUTOGRADER_COURSE"}
+    for job in flow["jobs"].values():
+        for step in job["steps"]:
+            if step.get("uses", "").startswith("actions/checkout"):
+                assert step["with"]["persist-credentials"] is False
+
+
+def test_github_shards_never_grades_as_the_runner_user(tmp_path: Path):
+    """Without root or sudo the grading step stops before grading anything: students'
+    programs would run as the runner user, who can read course/ and the network."""
+    flow = yaml.safe_load(render_workflow("github-shards", **VALUES))
+    step = next(s for s in flow["jobs"]["shard"]["steps"] if "grade-batch" in s.get("run", ""))
+    script = tmp_path / "step.sh"
+    script.write_text(step["run"].replace("${{ matrix.shard }}", "1"))
+    fakes = {"id": "echo 1001", "sudo": "exit 1",  # the runner user, who may not sudo
+             "autograder": f"touch {tmp_path / 'graded'}"}
+    for name, body in fakes.items():
+        (tmp_path / name).write_text(f"#!/bin/sh\n{body}\n")
+        (tmp_path / name).chmod(0o755)
+    proc = subprocess.run(["bash", "-e", str(script)], capture_output=True, text=True,
+                          cwd=tmp_path, env=dict(os.environ, PATH=f"{tmp_path}:/usr/bin:/bin"))
+    assert proc.returncode == 1
+    assert "::error::Grading needs root or sudo" in proc.stdout
+    assert not (tmp_path / "graded").exists()
 
 
 # --- Kubernetes -------------------------------------------------------------------------
