@@ -1,14 +1,17 @@
 """The CI templates render to valid YAML that runs our commands, and keep secrets where
 students' programs are not: none in a student's repository, a token only in the step that
-fetches the course."""
+fetches the course, and Kubernetes pods that meet Pod Security baseline."""
 
 import os
 import subprocess
 from pathlib import Path
 from typing import Any
 
+import kubernetes_validate
+import pytest
 import yaml
 from click.testing import CliRunner
+from pod_security import BASELINE, RESTRICTED, failures
 
 from autograder.cli import main
 from autograder.commands.workflows import render_workflow
@@ -16,6 +19,8 @@ from autograder.commands.workflows import render_workflow
 VALUES = {"exercise": "timer_sync", "submission": "src", "shards": 5,
           "platform_repo": "https://example.invalid/platform", "hidden_repo": "course/hidden",
           "claim": "data"}
+# The oldest and newest Kubernetes whose API schemas kubernetes-validate has.
+K8S_VERSIONS = ("1.25", kubernetes_validate.latest_version())
 
 
 def runs(steps: list[dict[str, Any]]) -> str:
@@ -105,10 +110,15 @@ def test_github_shards_never_grades_as_the_runner_user(tmp_path: Path):
     assert not (tmp_path / "graded").exists()
 
 
-# --- Kubernetes -------------------------------------------------------------------------
+# --- Kubernetes --------------------------------------------------------------------------
+
+def k8s_jobs() -> tuple[dict[str, Any], dict[str, Any]]:
+    grading, merging = yaml.safe_load_all(render_workflow("k8s-shards", **VALUES))
+    return grading, merging
+
 
 def test_kubernetes_indexed_job_and_merge_job():
-    job, merge = yaml.safe_load_all(render_workflow("k8s-shards", **VALUES))
+    job, merge = k8s_jobs()
     assert job["kind"] == "Job" and job["spec"]["completionMode"] == "Indexed"
     assert job["spec"]["completions"] == job["spec"]["parallelism"] == 5
     grader = job["spec"]["template"]["spec"]["containers"][0]
@@ -118,6 +128,72 @@ def test_kubernetes_indexed_job_and_merge_job():
     assert merge["kind"] == "Job" and merge["metadata"]["name"] == "merge-timer-sync"
     assert "autograder gradebook merge" in merge["spec"]["template"]["spec"]["containers"][0][
         "args"][0]
+
+
+@pytest.mark.parametrize("version", K8S_VERSIONS)
+def test_kubernetes_jobs_match_the_api_schema(version: str):
+    for job in k8s_jobs():
+        kubernetes_validate.validate(job, version, strict=True)
+
+
+def test_kubernetes_jobs_meet_baseline_and_fail_restricted_only_for_root_and_capabilities():
+    """What the recipe and the README say: baseline holds; restricted fails because the pods
+    run as root (its two non-root checks) and the grader keeps five capabilities."""
+    text = render_workflow("k8s-shards", **VALUES)
+    assert "kubectl label namespace grading pod-security.kubernetes.io/enforce=baseline" in text
+    grading, merging = k8s_jobs()
+    assert failures(grading, BASELINE) == failures(merging, BASELINE) == set()
+    assert failures(grading, RESTRICTED) == {"runAsNonRoot", "runAsUser",
+                                             "capabilities_restricted"}
+    assert failures(merging, RESTRICTED) == {"runAsNonRoot", "runAsUser"}
+
+
+def test_kubernetes_grader_keeps_only_what_giving_a_program_its_own_uid_needs():
+    grading, merging = k8s_jobs()
+    pod = grading["spec"]["template"]["spec"]
+    (grader,) = pod["containers"]
+    assert grader["securityContext"] == {
+        "runAsUser": 0, "allowPrivilegeEscalation": False,
+        "capabilities": {"drop": ["ALL"], "add": ["SETUID", "SETGID", "CHOWN", "FOWNER",
+                                                  "KILL"]}}
+    for spec in (pod, merging["spec"]["template"]["spec"]):
+        assert spec["securityContext"]["seccompProfile"] == {"type": "RuntimeDefault"}
+        assert spec["automountServiceAccountToken"] is False  # no API token to students
+        for container in spec.get("initContainers", []) + spec["containers"]:
+            assert container["securityContext"]["capabilities"]["drop"] == ["ALL"]
+            assert container["securityContext"]["allowPrivilegeEscalation"] is False
+
+
+def mount_at(container: dict[str, Any], path: str) -> dict[str, Any]:
+    """The volume mount a path in the container lies on: the deepest one above it."""
+    above = [m for m in container["volumeMounts"]
+             if path == m["mountPath"] or path.startswith(m["mountPath"].rstrip("/") + "/")]
+    return max(above, key=lambda m: len(m["mountPath"]))
+
+
+def test_kubernetes_grader_reads_submissions_read_only_and_writes_only_out():
+    grading, _ = k8s_jobs()
+    (grader,) = grading["spec"]["template"]["spec"]["containers"]
+    script = grader["args"][0]
+    assert "grade-batch timer_sync /data/submissions" in script
+    assert "--csv /data/out/gradebook-" in script and "--out /data/out/reports" in script
+    submissions = mount_at(grader, "/data/submissions/student01")
+    assert submissions["name"] == "data" and submissions["readOnly"] is True
+    out = mount_at(grader, "/data/out/reports")
+    assert out["name"] == "data" and out["subPath"] == "out" and not out.get("readOnly")
+
+
+def test_kubernetes_course_token_in_the_init_container_and_course_root_only():
+    grading, merging = k8s_jobs()
+    pod = grading["spec"]["template"]["spec"]
+    secrets = {v["name"] for v in pod["volumes"] if "secret" in v}
+    (sync,), (grader,) = pod["initContainers"], pod["containers"]
+    assert secrets and secrets <= {m["name"] for m in sync["volumeMounts"]}
+    assert not secrets & {m["name"] for m in grader["volumeMounts"]}
+    script = grader["args"][0]
+    assert script.startswith("chmod 0700 /course &&")  # before any student's program
+    assert "course" not in {m["name"] for m in
+                            merging["spec"]["template"]["spec"]["containers"][0]["volumeMounts"]}
 
 
 def test_cli_prints_a_workflow():

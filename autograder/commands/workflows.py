@@ -1,6 +1,11 @@
 """CI templates for a course: a student repository's grade-on-push workflow, and sharded
 batch grading on GitHub Actions (a matrix) or Kubernetes (an Indexed Job).
 
+Secrets stay where students' programs are not: the student's workflow runs the public
+tests and names none (students edit their own workflows); the course's token is used only
+to fetch the course, in the course's own repository or a pod's init container, never where
+a student's program runs. The Kubernetes Jobs meet Pod Security baseline.
+
 Templates live in ``autograder/templates/ci``; their placeholders are ``[[ name ]]`` so
 that GitHub's own ``${{ ... }}`` expressions pass through untouched.
 """
