@@ -13,7 +13,6 @@ with it; the sweep is for where there is no namespace to take them.
 from __future__ import annotations
 
 import contextlib
-import ctypes
 import os
 import shutil
 import signal
@@ -80,16 +79,14 @@ def kill_user(uid: int, timeout: float = 5.0) -> bool:
 # The machine's shared scratch folders, where a program without a mount namespace of its
 # own can leave files (POSIX shared memory is files in /dev/shm; queues in /dev/mqueue).
 SCRATCH = ("/tmp", "/var/tmp", "/dev/shm", "/dev/mqueue")
-IPC_RMID = 0
-# /proc/sysvipc/<kind>: the column of the id and of the owner, and how to remove one.
-_SYSV = {"shm": ("shmid", "uid", "shmctl"), "msg": ("msqid", "uid", "msgctl"),
-         "sem": ("semid", "uid", "semctl")}
+# /proc/sysvipc/<kind>: the column of each object's id.
+_SYSV = {"shm": "shmid", "msg": "msqid", "sem": "semid"}
 
 
 def user_ipc(uid: int, proc: str = "/proc") -> list[tuple[str, int]]:
     """The SysV IPC objects (kind, id) owned or created by ``uid``, in this namespace."""
     found = []
-    for kind, (id_column, _owner, _remove) in _SYSV.items():
+    for kind, id_column in _SYSV.items():
         try:
             with open(f"{proc}/sysvipc/{kind}") as fh:
                 header, *rows = [line.split() for line in fh]
@@ -103,21 +100,37 @@ def user_ipc(uid: int, proc: str = "/proc") -> list[tuple[str, int]]:
     return found
 
 
-def remove_user_ipc(uid: int) -> None:
-    """Remove every SysV IPC object of ``uid`` (a segment still attached goes once
-    detached: its last user is dead by now)."""
-    libc = ctypes.CDLL(None, use_errno=True)
-    for kind, ident in user_ipc(uid):
-        remove = getattr(libc, _SYSV[kind][2])
+# Run as the student's user: it owns what it made. Root without CAP_SYS_ADMIN (a container's)
+# may not remove another user's IPC objects, and without CAP_DAC_OVERRIDE (a Kubernetes
+# pod's) could not even list a 0700 folder of another user's. Arguments: "shm:ID",
+# "msg:ID", "sem:ID", or a path.
+_CLEAN = """\
+import ctypes, os, shutil, stat, sys
+libc = ctypes.CDLL(None)
+for item in sys.argv[1:]:
+    kind, _, ident = item.partition(":")
+    try:
         if kind == "sem":
-            remove(ident, 0, IPC_RMID)
+            libc.semctl(int(ident), 0, 0)  # IPC_RMID
+        elif kind in ("shm", "msg"):
+            getattr(libc, kind + "ctl")(int(ident), 0, None)  # IPC_RMID
+        elif os.path.isdir(item) and not os.path.islink(item):
+            os.chmod(item, stat.S_IRWXU)  # folders it made closed: its own to open again
+            for root, dirs, _files in os.walk(item):
+                for name in dirs:
+                    if not os.path.islink(os.path.join(root, name)):
+                        os.chmod(os.path.join(root, name), stat.S_IRWXU)
+            shutil.rmtree(item, ignore_errors=True)
         else:
-            remove(ident, IPC_RMID, None)
+            os.unlink(item)
+    except (OSError, ValueError):
+        pass
+"""
 
 
-def remove_user_files(uid: int, folders: tuple[str, ...] = SCRATCH) -> None:
-    """Remove what ``uid`` owns at the top of each scratch folder (a folder with all in it;
-    links themselves, never what they point to)."""
+def user_files(uid: int, folders: tuple[str, ...] = SCRATCH) -> list[str]:
+    """What ``uid`` owns at the top of each scratch folder."""
+    found = []
     for folder in folders:
         try:
             entries = list(os.scandir(folder))
@@ -125,18 +138,29 @@ def remove_user_files(uid: int, folders: tuple[str, ...] = SCRATCH) -> None:
             continue
         for entry in entries:
             with contextlib.suppress(OSError):
-                if entry.stat(follow_symlinks=False).st_uid != uid:
-                    continue
-                if entry.is_dir(follow_symlinks=False):
-                    shutil.rmtree(entry.path, ignore_errors=True)  # fd-based: no link races
-                else:
-                    os.unlink(entry.path)
+                if entry.stat(follow_symlinks=False).st_uid == uid:
+                    found.append(entry.path)
+    return found
+
+
+def remove_leftovers(uid: int, folders: tuple[str, ...] = SCRATCH) -> None:
+    """Remove every SysV IPC object of ``uid`` (a segment still attached goes once
+    detached: its last user is dead by now) and what it owns at the top of each scratch
+    folder (a folder with all in it; links themselves, never what they point to), acting
+    as ``uid``: after the sweep's kill nothing of it runs to race the removal."""
+    items = [f"{kind}:{ident}" for kind, ident in user_ipc(uid)] + user_files(uid, folders)
+    setpriv = shutil.which("setpriv")
+    if not items or setpriv is None:
+        return
+    subprocess.run([setpriv, f"--reuid={uid}", f"--regid={uid}", "--clear-groups",
+                    sys.executable, "-I", "-S", "-c", _CLEAN, *items], cwd="/",
+                   stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                   stderr=subprocess.DEVNULL, env={}, check=False, timeout=60)
 
 
 def sweep_user(uid: int) -> bool:
     """End every process of the student's ``uid``, then remove its IPC objects and scratch
     files; whether no process was left."""
     gone = kill_user(uid)
-    remove_user_ipc(uid)
-    remove_user_files(uid)
+    remove_leftovers(uid)
     return gone
