@@ -31,7 +31,8 @@ STAMP = VENV / ".installed"
 # pyproject.toml's dependencies less the ROS wheels (used with a system ROS install).
 NON_ROS_DEPENDENCIES = ["pymunk>=6.6", "numpy>=1.24", "jinja2>=3.1", "babel>=2.12",
                         "click>=8.1", "pytest>=7.4", "pyyaml>=6.0", "mcap>=1.1",
-                        "mcap-ros2-support>=0.5", "ruff>=0.5", "playwright>=1.40"]
+                        "mcap-ros2-support>=0.5", "ruff>=0.5", "playwright>=1.40",
+                        "kubernetes-validate>=1.37"]
 
 JOBS = {
     "demo": [["autograder", "grade", "parameter_validation",
