@@ -103,7 +103,7 @@ def main() -> None:
     from sim.procstate import read_process_state
 
     exercise = find_exercise(args.exercise)
-    for key, value in dds_env(Isolation(strict)).items():
+    for key, value in dds_env(Isolation("strict" if strict else "basic")).items():
         if value is None:
             os.environ.pop(key, None)
         else:

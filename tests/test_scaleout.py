@@ -2,7 +2,7 @@
 are rendered, parsed, and their commands run as a pod or a runner would run them.
 
 As in the pod: the commands run as root, from ``/``, with a PATH that has no ``unshare``
-(so isolation is basic, as in an unprivileged pod), no cgroup the platform can create
+(so isolation is by user, as in an unprivileged pod), no cgroup the platform can create
 (``AUTOGRADER_CGROUP_ROOT`` is a file), the course on a path of its own found only through
 ``AUTOGRADER_COURSE``, and the platform installed by the printed ``pip install`` into a
 fresh virtual environment. Only the install's source changes: the printed git URL becomes
@@ -131,12 +131,14 @@ def scores(book: Path) -> dict[str, str]:
 
 
 def graded_as_in_the_pod(reports: Path) -> set[str]:
-    """The students with results in ``reports``, each graded in basic isolation (there is
-    no unshare) and without a grader error."""
+    """The students with results in ``reports``, each graded in isolation by user (there
+    is no unshare: no namespaces, a user of its own all the same), officially, and without
+    a grader error."""
     graded = set()
     for path in reports.glob("*/results.json"):
         result = json.loads(path.read_text())
-        assert result["isolation"]["mode"] == "basic", result["isolation"]
+        assert result["isolation"]["mode"] == "user", result["isolation"]
+        assert result["isolation"]["official"] is True
         assert result.get("grader_error") is None, result
         graded.add(path.parent.name)
     return graded

@@ -26,7 +26,7 @@ class RunSettings:
     lifeline_fd: int | None = None  # a pipe that closes when the grader dies
     domain: int | None = None  # the ROS domain the grader reserved; None: reserve one
     real_time_factor: float | None = None  # overrides the exercise's
-    isolation: Literal["strict", "basic"] = "basic"  # as the grader chose it
+    isolation: Literal["strict", "user", "basic"] = "basic"  # as the grader chose it
     lang: str = "en"
     record: str | None = None  # a folder: each test module's graph recorded as a bag in it
     # The student's file as they named it (``mywork/avoider.py``): tracebacks and messages
@@ -39,6 +39,11 @@ class RunSettings:
     @property
     def strict(self) -> bool:
         return self.isolation == "strict"
+
+    @property
+    def own_user(self) -> bool:
+        """The student's program runs as a user of its own (strict or user isolation)."""
+        return self.isolation in ("strict", "user")
 
     def to_json(self) -> str:
         return json.dumps(dataclasses.asdict(self))

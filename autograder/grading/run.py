@@ -31,7 +31,14 @@ from autograder.grading.footprint import Footprint
 from autograder.grading.modules import ModuleJobs, children_for, find_modules, merge, share_out
 from autograder.i18n import _, get_language
 from autograder.sandbox.domains import DomainLock, NoDomain, hold_domain
-from autograder.sandbox.isolation import Isolation, detect, run_prefix, student_uid
+from autograder.sandbox.isolation import (
+    Isolation,
+    close_to_others,
+    detect,
+    protected_paths,
+    run_prefix,
+    student_uid,
+)
 
 GRADER_FAULT = "the autograder failed, tell your instructor"
 
@@ -55,6 +62,8 @@ def grade(exercise: Exercise, submission: Path | None, *, hidden: bool = True,
     """
     started = time.monotonic()
     isolation = detect()
+    if isolation.mode == "user":  # no mount namespace hides them: permissions must
+        close_to_others(protected_paths(exercise.folder.parent.parent))
     record, warnings = _record_folder(record)
     plan = _Plan.of(exercise, hidden)
     wanted = 1 if domain is not None else children_for(module_jobs, len(plan.modules),
@@ -75,13 +84,13 @@ def grade(exercise: Exercise, submission: Path | None, *, hidden: bool = True,
     processes = [{k: v for k, v in p.items() if k != "workdir"} for p in raw.processes]
     bounds = processes[0].get("bounds") if processes else None
     first = locks[0].domain
+    # Each child's students run as the user of its domain.
+    uids = [student_uid(lock.domain) for lock in locks] if isolation.own_user else None
     return dataclasses.replace(result, data={
-        **result.data, "isolation": {**isolation.to_dict(), "bounds": bounds},
+        **result.data,
+        "isolation": {**isolation.to_dict(), "bounds": bounds, "student_uids": uids},
         "domain": first, "domains": [lock.domain for lock in locks], "processes": processes,
-        "student_uid": student_uid(first) if isolation.strict else None,
-        # Each child's students run as the user of its domain.
-        "student_uids": [student_uid(lock.domain) for lock in locks] if isolation.strict
-        else None})
+        "student_uid": uids[0] if uids else None, "student_uids": uids})
 
 
 def _more_domains(stack: contextlib.ExitStack, count: int) -> list[DomainLock]:

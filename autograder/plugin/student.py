@@ -126,7 +126,7 @@ def _launch(request: pytest.FixtureRequest, exercise: Exercise, script: Path, pr
 
     process = student_process(script, ros_args, exercise.limits,
                               domain=int(os.environ["ROS_DOMAIN_ID"]),
-                              strict=request.config.stash[settings_key].strict,
+                              mode=request.config.stash[settings_key].isolation,
                               course=exercise.folder.parent.parent)
     # An earlier instance may still be on the graph: its name until its participant's
     # lease runs out, some of its endpoints too. Only publishers that were not there

@@ -65,7 +65,7 @@ def ros_context(pytestconfig: pytest.Config) -> Iterator[Context]:
     settings = pytestconfig.stash[settings_key]
     if settings.strict:
         bring_up_loopback()  # the run's own network namespace starts with lo down
-    for key, value in dds_env(Isolation(settings.strict)).items():
+    for key, value in dds_env(Isolation(settings.isolation)).items():
         if value is None:
             os.environ.pop(key, None)
         else:

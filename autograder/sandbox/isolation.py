@@ -11,9 +11,21 @@ user and traffic silently stops (measured), and ``ROS_AUTOMATIC_DISCOVERY_RANGE=
 LOCALHOST`` also cut the student off from a root peer (measured), while the namespace
 already confines discovery to loopback.
 
-**Basic** (anything else): process group and session, resource limits, cgroups where
-writable, a throwaway working directory, ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``.
-The student runs as the grader's user and can read what the grader can; results say so.
+**User** (the grader runs as root where namespaces are refused: Gradescope's container, a
+Kubernetes pod, both without ``CAP_SYS_ADMIN``): the student still runs as a user of its
+own, switched to with ``CAP_SETUID``/``CAP_SETGID``, which Docker and Kubernetes keep by
+default. What namespaces did is done by ownership and mode: the course's protected folders
+are closed to other users (:func:`close_to_others`), the student's folder is its own
+(0700), and whatever its user leaves is swept (:mod:`autograder.sandbox.sweep`). Fast DDS
+speaks UDP on loopback only (:data:`LOOPBACK_PROFILE`): with shared memory the student's
+user cannot use segments root made, and ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST`` cut a
+root participant off from another user's (both measured). The program keeps the network
+and sees the machine's processes: no namespace can take them away here.
+
+**Basic** (anything else: an ordinary user; ``AUTOGRADER_ISOLATION=basic``): process
+group and session, resource limits, cgroups where writable, a throwaway working
+directory, ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``. The student runs as the grader's
+user and can read, stop and change what the grader can: its results are not official.
 """
 
 from __future__ import annotations
@@ -25,28 +37,44 @@ import shutil
 import subprocess
 import sys
 from pathlib import Path
+from typing import Literal
 
+from autograder.core.errors import GraderError
 from autograder.i18n import N_
 from autograder.sandbox.privileged import PACKAGE_PARENT, SAFE_CWD, module_command
 from autograder.sandbox.sweep import STUDENT_UID_BASE
+
+Mode = Literal["strict", "user", "basic"]
 
 
 @dataclasses.dataclass(frozen=True)
 class Isolation:
     """What this machine allows; ``reason`` says why strict isolation is off."""
 
-    strict: bool
+    mode: Mode
     reason: str = ""
     detail: str = ""
 
     @property
-    def mode(self) -> str:
-        return "strict" if self.strict else "basic"
+    def strict(self) -> bool:
+        """Namespaces of its own: network, mounts, IPC, /proc (and a user of its own)."""
+        return self.mode == "strict"
+
+    @property
+    def own_user(self) -> bool:
+        """The student runs as a user of its own, not the grader's."""
+        return self.mode in ("strict", "user")
+
+    @property
+    def official(self) -> bool:
+        """Whether the student's program could not read the hidden tests or change the
+        result: grades from this shape may go in a gradebook."""
+        return self.own_user
 
     def to_dict(self) -> dict[str, object]:
-        return {"mode": self.mode, "separate_user": self.strict, "network": not self.strict,
-                "hidden_files_protected": self.strict, "reason": self.reason,
-                "detail": self.detail}
+        return {"mode": self.mode, "official": self.official, "separate_user": self.own_user,
+                "network": not self.strict, "hidden_files_protected": self.own_user,
+                "reason": self.reason, "detail": self.detail}
 
 
 def student_uid(domain: int) -> int:
@@ -60,28 +88,50 @@ def detect() -> Isolation:
     way every student's program is (:func:`autograder.sandbox.process.student_process`, in the
     run's namespaces) runs Python and rclpy as a user of its own: if the check passes,
     launches work; if not, basic isolation is used and the reason is kept."""
-    if os.environ.get("AUTOGRADER_ISOLATION") == "basic":
-        return Isolation(False, N_("basic isolation was asked for (AUTOGRADER_ISOLATION)"))
+    asked = os.environ.get("AUTOGRADER_ISOLATION")
+    if asked == "basic":
+        return Isolation("basic", N_("basic isolation was asked for (AUTOGRADER_ISOLATION)"))
     if os.geteuid() != 0:
-        return Isolation(False, N_("the grader does not run as root"))
-    unshare = shutil.which("unshare")
-    if unshare is None:
-        return Isolation(False, N_("the unshare command (util-linux) is missing"))
+        return Isolation("basic", N_("the grader does not run as root"))
+    if asked == "user":
+        strict = Isolation("user", N_("isolation by user was asked for "
+                                      "(AUTOGRADER_ISOLATION)"))
+    elif shutil.which("unshare") is None:
+        strict = Isolation("user", N_("the unshare command (util-linux) is missing"))
+    else:
+        strict = _probe(Isolation("strict"))
+        if strict.mode == "strict":
+            return strict
+    # No namespaces: a user of its own all the same, if a test program runs as one.
+    own = _probe(Isolation("user", strict.reason, strict.detail))
+    if own.mode == "user":
+        return own
+    return Isolation("basic", own.reason, " / ".join(d for d in (strict.detail, own.detail)
+                                                      if d))
+
+
+def _probe(isolation: Isolation) -> Isolation:
+    """``isolation`` if a test program runs in it as a student's does; else basic, why."""
     try:
         probe = subprocess.run(
-            [*run_prefix(Isolation(True)), *module_command("autograder.sandbox.isolation", [])],
+            [*run_prefix(isolation),
+             *module_command("autograder.sandbox.isolation", [isolation.mode])],
             capture_output=True, text=True, timeout=120, cwd=SAFE_CWD)
     except subprocess.TimeoutExpired:
-        return Isolation(False, N_("a test program could not run in strict isolation"),
-                         "no answer within 120 s")
-    if probe.returncode != 0:
-        detail = " / ".join((probe.stdout + probe.stderr).strip().splitlines()[-3:])
-        if probe.stderr.startswith("unshare:"):  # the namespaces themselves were refused
-            return Isolation(False, N_("namespaces are not allowed here (an unprivileged "
-                                       "container?)"), detail)
-        return Isolation(False, N_("a test program could not run in strict isolation"),
-                         detail)
-    return Isolation(True)
+        return Isolation("basic", _could_not(isolation), "no answer within 120 s")
+    if probe.returncode == 0:
+        return isolation
+    detail = " / ".join((probe.stdout + probe.stderr).strip().splitlines()[-3:])
+    if probe.stderr.startswith("unshare:"):  # the namespaces themselves were refused
+        return Isolation("basic", N_("namespaces are not allowed here (an unprivileged "
+                                     "container?)"), detail)
+    return Isolation("basic", _could_not(isolation), detail)
+
+
+def _could_not(isolation: Isolation) -> str:
+    if isolation.strict:
+        return N_("a test program could not run in strict isolation")
+    return N_("a test program could not run as a user of its own")
 
 
 # What the start-up check's test program runs: Python, rclpy and its middleware.
@@ -95,20 +145,21 @@ print("autograder-probe-ok", os.getuid())
 """
 
 
-def probe_launch() -> str | None:
-    """Start a test program exactly as a student's is started in strict isolation; None if
-    it ran as its own user, else what went wrong. Runs inside the run's namespaces."""
+def probe_launch(mode: Mode = "strict") -> str | None:
+    """Start a test program exactly as a student's is started in isolation ``mode``; None
+    if it ran as its own user, else what went wrong. Runs inside the run's namespaces."""
     import tempfile
 
     from autograder.core.exercise import Limits
     from autograder.sandbox.process import LaunchFailed, student_process
 
-    bring_up_loopback()
+    if mode == "strict":
+        bring_up_loopback()
     with tempfile.TemporaryDirectory(prefix="autograder-probe-") as tmp:
         script = Path(tmp) / "staged" / "probe.py"
         script.parent.mkdir()
         script.write_text(PROBE_PROGRAM)
-        process = student_process(script, [], Limits(), domain=0, strict=True,
+        process = student_process(script, [], Limits(), domain=0, mode=mode,
                                   course=Path(PACKAGE_PARENT))
         try:
             process.start()
@@ -138,11 +189,17 @@ FASTDDS_PROFILE = Path(__file__).with_name("fastdds_profile.xml")
 """Fast DDS settings for every process of a run: faster participant discovery (the file
 says why). A student's program gets a copy in its working directory (process.py): in
 strict isolation it cannot read the grader's package."""
+LOOPBACK_PROFILE = Path(__file__).with_name("fastdds_loopback.xml")
+"""The same settings, and UDP on 127.0.0.1 as the only transport: isolation by user, where
+no network namespace keeps discovery on loopback."""
 PROFILE_ENV = "FASTRTPS_DEFAULT_PROFILES_FILE"  # Fast DDS 2.x, Jazzy's middleware
 
 
 def dds_env(isolation: Isolation) -> dict[str, str | None]:
     """Middleware settings for every process of the run (None: unset)."""
+    if isolation.mode == "user":  # the profile's transport, nothing built in
+        return {"FASTDDS_BUILTIN_TRANSPORTS": None, "ROS_AUTOMATIC_DISCOVERY_RANGE": None,
+                PROFILE_ENV: str(LOOPBACK_PROFILE)}
     profile = {PROFILE_ENV: str(FASTDDS_PROFILE)}
     if isolation.strict:
         return {"FASTDDS_BUILTIN_TRANSPORTS": "UDPv4", "ROS_AUTOMATIC_DISCOVERY_RANGE": None,
@@ -171,8 +228,28 @@ def protected_paths(course: Path) -> list[Path]:
                                           root / "quizzes") if p.exists()]
 
 
+def close_to_others(paths: list[Path]) -> list[Path]:
+    """Take every permission of other users off each of ``paths`` (the folder itself:
+    nobody else gets into it, whatever it holds); the ones changed. For isolation by user,
+    where no mount namespace covers them: a student's user is "other" to every file of
+    the grader's (it has no group but its own)."""
+    changed = []
+    for path in paths:
+        mode = path.lstat().st_mode
+        if mode & 0o007 and not path.is_symlink():
+            try:
+                path.chmod(mode & 0o7770)
+            except OSError as exc:  # a read-only mount: it must come closed
+                raise GraderError(
+                    f"{path} is open to other users and cannot be closed ({exc.strerror}): "
+                    f"a student's program could read it. Make it the grader's, mode 0700 "
+                    f"(or 0750), before grading.") from None
+            changed.append(path)
+    return changed
+
+
 if __name__ == "__main__":
-    problem = probe_launch()
+    problem = probe_launch(*sys.argv[1:2])  # type: ignore[arg-type]
     if problem is not None:
         print(problem)
         sys.exit(1)

@@ -49,16 +49,18 @@ STRICT_WORKDIR_PREFIX = "autograder-student-"
 
 
 def student_process(script: Path, ros_args: list[str], limits: Limits, *, domain: int,
-                    strict: bool, course: Path) -> StudentProcess:
+                    course: Path, strict: bool = False,
+                    mode: str | None = None) -> StudentProcess:
     """The student's program as every launch prepares it: a copy of ``script`` and its
     sibling modules in a working directory of its own, a minimal environment on ROS
-    domain ``domain``, and in strict isolation a user of its own with the course hidden.
+    domain ``domain``, and in isolation ``mode`` (``strict``, ``user``, ``basic``;
+    ``strict=True`` says ``strict``) a user of its own, with the course hidden by
+    namespaces (strict) or closed to it by permissions (user: see ``grading.run``).
 
     The grading (``autograder.plugin.launch``) and strict isolation's start-up check
     (``autograder.sandbox.isolation``) both start programs through here, so the check proves what
     a real launch does."""
     from autograder.sandbox.isolation import (
-        FASTDDS_PROFILE,
         PROFILE_ENV,
         Isolation,
         dds_env,
@@ -66,20 +68,26 @@ def student_process(script: Path, ros_args: list[str], limits: Limits, *, domain
         student_uid,
     )
 
-    # Strict: a folder outside the grader's (0700) run folder, turned into the student's
-    # own tmpfs by the launcher. Basic: a throwaway folder beside the staged copy.
-    workdir = Path(tempfile.mkdtemp(prefix=STRICT_WORKDIR_PREFIX if strict else "student-",
-                                    dir=None if strict else script.parent.parent))
+    isolation = Isolation(mode or ("strict" if strict else "basic"))  # type: ignore[arg-type]
+    # A user of its own: a folder outside the grader's (0700) run folder, which the
+    # launcher turns into the student's own tmpfs (strict) or gives to its user (user).
+    # Basic: a throwaway folder beside the staged copy.
+    own = isolation.own_user
+    workdir = Path(tempfile.mkdtemp(prefix=STRICT_WORKDIR_PREFIX if own else "student-",
+                                    dir=None if own else script.parent.parent))
     for source in script.parent.glob("*.py"):
         (workdir / source.name).write_bytes(source.read_bytes())
+    middleware = dds_env(isolation)
     profile = workdir / STUDENT_PROFILE
-    profile.write_bytes(FASTDDS_PROFILE.read_bytes())
-    env = minimal_env(workdir, {"ROS_DOMAIN_ID": str(domain), **dds_env(Isolation(strict)),
+    profile.write_bytes(Path(middleware[PROFILE_ENV] or "").read_bytes())
+    env = minimal_env(workdir, {"ROS_DOMAIN_ID": str(domain), **middleware,
                                 PROFILE_ENV: str(profile)})
     process = StudentProcess(workdir / script.name, workdir, ros_args, env, limits)
-    if strict:
+    if own:
         process.uid = student_uid(domain)
-        process.hide = protected_paths(course)
+        process.namespaces = isolation.strict
+        if isolation.strict:
+            process.hide = protected_paths(course)
     return process
 
 
@@ -275,6 +283,7 @@ class StudentProcess:
     cgroup: Cgroup | None = None
     output: _Output | None = None
     uid: int | None = None
+    namespaces: bool = True  # with ``uid``: strict isolation's namespaces, or none (user)
     hide: list[Path] = dataclasses.field(default_factory=list)
     workdir_mb: int = 64
     started_at: float = 0.0
@@ -298,8 +307,8 @@ class StudentProcess:
                                    "cgroups": [str(p) for p in self.cgroup.paths],
                                    "workdir": str(self.workdir)}
         if self.uid is not None:
-            spec.update(uid=self.uid, hide=[str(p) for p in self.hide],
-                        workdir_mb=self.workdir_mb)
+            spec.update(uid=self.uid, namespaces=self.namespaces,
+                        hide=[str(p) for p in self.hide], workdir_mb=self.workdir_mb)
         args = ["--ros-args", *self.ros_args]
         self.output = _Output(self.limits.output_kb * 1024)
         launcher_env = dict(self.env)
