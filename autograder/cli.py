@@ -151,9 +151,24 @@ def start(exercise: str, directory: Path | None) -> None:
         file=target / found.file, exercise=found.id))
 
 
+def refuse_unofficial(option: str) -> None:
+    """End with a grader fault, naming why, where this machine cannot give an official
+    grade (the student's program would run as the grader's user): recipes that produce
+    grades for a gradebook never hand out a grade a program could have changed."""
+    from autograder.sandbox.isolation import detect
+
+    isolation = detect()
+    if not isolation.official:
+        raise GraderFault(_(
+            "This machine cannot give official grades ({reason}): a student's program would "
+            "run as the grader's user and could change its result. Grade as root (README: "
+            "\"Untrusted code\"), or pass {option} to grade anyway, unofficially.").format(
+            reason=_(isolation.reason), option=option))
+
+
 def _run(exercise: str, submission: Path, hidden: bool, outputs: dict[str, Path | None],
          rtf: float | None, domain: int | None, record: Path | None = None,
-         module_jobs: int | str = "auto") -> None:
+         module_jobs: int | str = "auto", require_official: bool = False) -> None:
     from autograder.core.report import RawTest
     from autograder.core.submission import SubmissionNotFound, check
     from autograder.grading.run import grade, result_of
@@ -161,6 +176,8 @@ def _run(exercise: str, submission: Path, hidden: bool, outputs: dict[str, Path 
     from autograder.render.terminal import for_terminal, heading, rtl_notice, to_terminal
 
     found = _exercise(exercise)
+    if require_official:
+        refuse_unofficial("--no-require-official")
     try:
         check(submission, found.file)  # a link, device or FIFO: the student's clear error
     except SubmissionNotFound as exc:
@@ -302,13 +319,18 @@ def check(exercise: str, submission: Path, rtf: float | None, domain: int | None
 @_domain
 @_module_jobs
 @_record
+@click.option("--require-official/--no-require-official", default=False, show_default=True,
+              help="Refuse to grade (a grader fault, exit 3) where the grade could not be "
+                   "official: the student's program would run as the grader's user. The "
+                   "Gradescope bundle grades with it.")
 @_lang_option
 def grade_command(exercise: str, submission: Path, rtf: float | None, domain: int | None,
-                  module_jobs: int | str, record: Path | None,
+                  module_jobs: int | str, record: Path | None, require_official: bool,
                   **outputs: Path | None) -> None:
     """Run the public and hidden tests of EXERCISE on SUBMISSION (the student's .py file or a
     folder holding it)."""
-    _run(exercise, submission, True, outputs, rtf, domain, record, module_jobs)
+    _run(exercise, submission, True, outputs, rtf, domain, record, module_jobs,
+         require_official)
 
 
 @main.command()
@@ -363,12 +385,22 @@ def bundle_gradescope(exercise: str, zip_path: Path) -> None:
 @click.option("--module-jobs", type=_MODULE_JOBS, default=None,
               help="Test modules run at the same time within each grading (default: auto "
                    "with --jobs 1, else 1: the gradings share the cores).")
+@click.option("--allow-unofficial", is_flag=True, default=False,
+              help="Grade exercises even where the grades cannot be official (the students' "
+                   "programs would run as the grader's user); they say so.")
 @_lang_option
 def grade_batch(item: str, submissions: Path, jobs: int | str, csv_path: Path, out: Path | None,
-                shard: str | None, record: Path | None, module_jobs: int | str | None) -> None:
+                shard: str | None, record: Path | None, module_jobs: int | str | None,
+                allow_unofficial: bool) -> None:
     """Grade every submission in SUBMISSIONS (one sub-folder or file per student), or score
-    every answers file for a quiz. Resumable: graded students are skipped."""
+    every answers file for a quiz. Resumable: graded students are skipped. Exercises are
+    graded only where the grades are official, unless --allow-unofficial."""
     from autograder.commands.batch import parse_shard, run_batch, students
+
+    if _exercise_or_none(item) is not None:
+        if not allow_unofficial:
+            refuse_unofficial("--allow-unofficial")
+        _close_class(submissions, out or Path("grades") / item)
 
     try:
         share = parse_shard(shard) if shard else None
@@ -396,6 +428,16 @@ def grade_batch(item: str, submissions: Path, jobs: int | str, csv_path: Path, o
                      shard=share, extra=extra, progress=progress)
     click.echo(ngettext("{count} row in {path}", "{count} rows in {path}", len(rows)).format(
         count=len(rows), path=csv_path))
+
+
+def _close_class(submissions: Path, out: Path) -> None:
+    """Isolation by user: no namespace hides the other students' submissions and reports
+    from a student's program, so their folders are closed to other users."""
+    from autograder.sandbox.isolation import close_to_others, detect
+
+    if detect().mode == "user":
+        out.mkdir(parents=True, exist_ok=True)
+        close_to_others([submissions, out])
 
 
 def _exercise_or_none(item: str):  # noqa: ANN202 - an Exercise, or None

@@ -112,7 +112,8 @@ VENV="${{AUTOGRADER_VENV:-$ROOT/venv}}"
 mkdir -p "$ROOT/results"
 cd "$ROOT/source"
 AUTOGRADER_COURSE="$ROOT/source" "$VENV/bin/autograder" grade {exercise} "$ROOT/submission" \\
-    --gradescope "$ROOT/results/results.json" --results "$ROOT/results/ours.json"
+    --require-official --gradescope "$ROOT/results/results.json" \\
+    --results "$ROOT/results/ours.json"
 status=$?
 if [ ! -s "$ROOT/results/results.json" ]; then
   # The grader could not even start: say so rather than leave Gradescope without results.

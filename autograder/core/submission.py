@@ -72,12 +72,16 @@ def read_untrusted(path: Path, limit: int = MAX_FILE_BYTES) -> bytes:
     try:
         mode = os.fstat(fd).st_mode
         if not stat.S_ISREG(mode):
-            kind = (_("a folder") if stat.S_ISDIR(mode) else _("a FIFO")
-                    if stat.S_ISFIFO(mode) else _("a device") if stat.S_ISCHR(mode)
-                    or stat.S_ISBLK(mode) else _("a special file"))
-            raise SubmissionRefused(_(
-                "{file} is {kind}, not a regular file: submit the file itself").format(
-                file=path.name, kind=kind))
+            if stat.S_ISDIR(mode):
+                message = _("{file} is a folder, not a regular file: submit the file itself")
+            elif stat.S_ISFIFO(mode):
+                message = _("{file} is a FIFO, not a regular file: submit the file itself")
+            elif stat.S_ISCHR(mode) or stat.S_ISBLK(mode):
+                message = _("{file} is a device, not a regular file: submit the file itself")
+            else:
+                message = _("{file} is a special file, not a regular file: submit the file "
+                            "itself")
+            raise SubmissionRefused(message.format(file=path.name))
         chunks, size = [], 0
         while chunk := os.read(fd, 65536):
             size += len(chunk)

@@ -49,6 +49,7 @@ class Child:
     log_path: Path
     launched: float  # monotonic, the same clock in both processes
     timed_out: bool = False
+    stopped: bool = False  # something stopped it (SIGSTOP): what it reports is not trusted
     # The report's tests as last read, and the file's (inode, size, mtime) then.
     tests: list[RawTest] = dataclasses.field(default_factory=list)
     seen: tuple[int, int, int] | None = None
@@ -78,12 +79,14 @@ class Ended:
     timed_out: bool
     pytest_log: str
     launched: float
+    stopped: bool = False
 
     @property
     def broken(self) -> bool:
         """It ended without reporting its tests: a crash or a test file that does not
-        import, or the time limit before any test was collected."""
-        return (self.returncode not in (0, 1) and not self.timed_out) or (
+        import, or the time limit before any test was collected; or something stopped it
+        (a program of the grader's own user, in basic isolation): never a verdict."""
+        return (self.returncode not in (0, 1) and not self.timed_out) or self.stopped or (
             not self.raw.forged and not self.raw.tests)
 
 
@@ -163,6 +166,11 @@ def wait(children: Sequence[Child], limit: float, watchers: Watchers,
     reported: set[str] = set()
     while True:
         live = [c for c in children if c.process.poll() is None]
+        for child in live:
+            if _stopped(child.process.pid):  # only a signal from outside stops it
+                os.killpg(child.process.pid, signal.SIGKILL)
+                child.process.wait()
+                child.stopped = True
         if live and footprint is not None:
             footprint.sample()
         if live:
@@ -182,6 +190,15 @@ def wait(children: Sequence[Child], limit: float, watchers: Watchers,
                     child.process.wait()
                     child.timed_out = True
             return
+
+
+def _stopped(pid: int) -> bool:
+    """Whether process ``pid`` is stopped (``T``) or held by a tracer (``t``)."""
+    try:
+        with open(f"/proc/{pid}/stat", "rb") as fh:
+            return fh.read().rpartition(b")")[2].split()[0] in (b"T", b"t")
+    except (OSError, IndexError):
+        return False
 
 
 def _tell(children: Sequence[Child], reported: set[str], watchers: Watchers) -> RawTest | None:
@@ -208,5 +225,9 @@ def end(child: Child) -> Ended:
         os.killpg(child.process.pid, signal.SIGKILL)
     for process in raw.processes:
         reap_recorded(process)
-    return Ended(raw, child.process.returncode, child.timed_out,
-                 child.log_path.read_text(errors="replace"), child.launched)
+    log = child.log_path.read_text(errors="replace")
+    if child.stopped:
+        log += ("\nThe grading's pytest process was stopped from outside (SIGSTOP or a "
+                "tracer): its report is not trusted.\n")
+    return Ended(raw, child.process.returncode, child.timed_out, log, child.launched,
+                 child.stopped)

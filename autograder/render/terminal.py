@@ -159,11 +159,19 @@ def isolation_line(isolation: dict) -> str:
     limits = _("processes bounded by {processes}, memory by {memory}").format(
         processes=_bound(bounds.get("processes"), bounds.get("cgroup"), "pids", "RLIMIT_NPROC"),
         memory=_bound(bounds.get("memory"), bounds.get("cgroup"), "memory", "RLIMIT_AS"))
-    if isolation.get("mode") == "strict":
+    mode = isolation.get("mode")
+    if mode == "strict":
         return _("Isolation: strict (a user of its own, no network, the course hidden); "
                  "{limits}.").format(limits=limits)
-    return _("Isolation: basic, {reason}; the program ran as the grader's user; "
-             "{limits}.").format(reason=_(isolation.get("reason", "")), limits=limits)
+    if mode == "user":
+        return _("Isolation: by user, {reason}: a user of its own, the course closed to it, "
+                 "but the network and the machine's processes in its reach; {limits}."
+                 ).format(reason=_(isolation.get("reason", "")), limits=limits)
+    return "\n".join((
+        _("Isolation: basic, {reason}; the program ran as the grader's user; {limits}."
+          ).format(reason=_(isolation.get("reason", "")), limits=limits),
+        _("Not an official grade: a program run as the grader's user could read the hidden "
+          "tests and change these results.")))
 
 
 def to_terminal(result: RunResult, color: bool = False, shown: Collection[str] = (),
