@@ -263,6 +263,15 @@ def test_ipc_objects_and_scratch_files_go_with_the_program(graded):
 
 
 @strict_only
+def test_classmates_are_out_of_reach(graded):
+    """Other students' submissions and results anywhere on the machine (this checkout's
+    corpus among them) are covered by the mount namespace."""
+    result = graded["reads_classmates"][0]
+    assert result.score == result.max_score
+    assert "CLASSMATES READ: 0" in result.log and "CLASSMATE /" not in result.log
+
+
+@strict_only
 def test_the_machines_processes_are_out_of_sight_and_reach(graded):
     """No other user's process is listed, stopped or traced; no privilege can be gained."""
     result = graded["snoops_processes"][0]
