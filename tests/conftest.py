@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
 from collections.abc import Iterable, Iterator
 from pathlib import Path
@@ -22,6 +23,18 @@ def ros_domain() -> Iterator[int]:
     os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
     with reserve_domain() as domain:
         yield domain
+
+
+@contextlib.contextmanager
+def modes_kept(paths: Iterable[Path]) -> Iterator[None]:
+    """Put back the modes of ``paths`` afterwards: isolation by user closes the course's
+    folders to other users at each grading, and this checkout is one of them."""
+    kept = {path: path.stat().st_mode for path in paths if path.exists()}
+    try:
+        yield
+    finally:
+        for path, mode in kept.items():
+            path.chmod(mode)
 
 
 # -- the exercises' proofs (tests/proving.py) ------------------------------------------------

@@ -153,3 +153,73 @@ def test_the_watch_looks_on_its_own(graph):
     finally:
         watch.stop()
     assert watch.charge() == [CLOCK]
+
+
+# -- the wire: strangers on the domain, the student on another's ------------------------
+GRADER, STUDENT, OTHER = 0, 200012, 200013
+
+
+def _wired(graph: _Graph, sockets: list[tuple[int, int]], student: int = STUDENT,
+           ) -> GraphWatch:
+    from autograder.plugin.guard import Wire
+
+    wire = Wire(domain=12, grader=frozenset({GRADER}), student=student,
+                read=lambda: list(sockets))
+    return GraphWatch(_Probe(graph), clock=_Clock(), wire=wire)
+
+
+def test_the_grader_and_the_student_on_the_domain_are_nobody_to_charge(graph):
+    watch = _wired(graph, [(12, GRADER), (12, STUDENT), (13, GRADER), (30, OTHER)])
+    assert watch.charge_split() == ([], [])
+
+
+def test_another_users_socket_on_the_domain_is_a_disturbance_not_the_students(graph):
+    """A classmate's program joined this grading's domain: the student is not blamed."""
+    sockets = [(12, GRADER), (12, OTHER)]
+    watch = _wired(graph, sockets)
+    assert watch.charge_split() == (
+        [], ["a program of another user (uid 200013) joined this grading's ROS domain 12"])
+    sockets.remove((12, OTHER))
+    assert watch.charge_split() == ([], [])  # gone: the next test is not disturbed
+
+
+def test_the_students_socket_on_another_domain_is_tampering(graph):
+    """The student's program joined another grading's domain: its own test fails."""
+    watch = _wired(graph, [(12, STUDENT), (40, STUDENT)])
+    assert watch.charge_split() == (["your program joined ROS domain 40, which is not its "
+                                     "own"], [])
+
+
+def test_the_grading_s_other_modules_are_the_same_student_not_strangers(graph):
+    """A grading runs its modules in children on domains of their own, each with its
+    user: the student's program of another module on this domain is no stranger (its own
+    module's watch fails it for joining a domain not its own)."""
+    from autograder.plugin.guard import Wire
+
+    wire = Wire(domain=12, grader=frozenset({GRADER}), student=STUDENT,
+                read=lambda: [(12, OTHER)], students=frozenset({STUDENT, OTHER}))
+    assert wire.look() == []
+
+
+def test_in_basic_isolation_only_other_users_are_strangers(graph):
+    """The student runs as the grader's user there: its sockets cannot be told from the
+    grader's anywhere; another user's on the domain are a stranger's."""
+    watch = _wired(graph, [(12, GRADER), (40, GRADER), (12, 1001)], student=GRADER)
+    assert watch.charge_split() == (
+        [], ["a program of another user (uid 1001) joined this grading's ROS domain 12"])
+
+
+def test_ports_the_kernel_hands_out_belong_to_no_domain():
+    """Fast DDS's own sending sockets take ports from the kernel's ephemeral range, which
+    overlaps the blocks of domains above 100: those are nobody's domain, never a join."""
+    from autograder.sandbox.domains import (
+        DOMAIN_GAIN,
+        PORT_BASE,
+        domain_of_port,
+        ephemeral_low,
+    )
+
+    assert domain_of_port(PORT_BASE + DOMAIN_GAIN * 12 + 11) == 12
+    assert domain_of_port(ephemeral_low()) is None
+    assert domain_of_port(ephemeral_low() + 1234) is None
+    assert domain_of_port(PORT_BASE - 1) is None

@@ -263,6 +263,14 @@ def test_ipc_objects_and_scratch_files_go_with_the_program(graded):
 
 
 @strict_only
+def test_no_other_grading_is_in_reach(graded):
+    """Each grading has a network namespace of its own: no other domain's ports to join."""
+    result = graded["joins_other_domain"][0]
+    assert result.score == result.max_score and result.grader_error is None
+    assert "JOINED DOMAIN" not in result.log
+
+
+@strict_only
 def test_classmates_are_out_of_reach(graded):
     """Other students' submissions and results anywhere on the machine (this checkout's
     corpus among them) are covered by the mount namespace."""

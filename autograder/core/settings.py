@@ -25,6 +25,9 @@ class RunSettings:
     key_fd: int | None = None  # a pipe holding the report's signing key
     lifeline_fd: int | None = None  # a pipe that closes when the grader dies
     domain: int | None = None  # the ROS domain the grader reserved; None: reserve one
+    # Every domain of the grading, this child's among them: its other children's students
+    # are the same student's program (the tampering guard tells them from strangers).
+    domains: tuple[int, ...] = ()
     real_time_factor: float | None = None  # overrides the exercise's
     isolation: Literal["strict", "user", "basic"] = "basic"  # as the grader chose it
     lang: str = "en"

@@ -178,6 +178,7 @@ def _run(exercise: Exercise, submission: Path | None, plan: _Plan,
     memory, for a start or two a child)."""
     targets = plan.targets(len(locks))
     settings = RunSettings(
+        domains=tuple(lock.domain for lock in locks),
         exercise=str(exercise.folder),
         submission=str(Path(submission).resolve()) if submission is not None else None,
         course=str(exercise.folder.parent.parent), real_time_factor=real_time_factor,

@@ -1,15 +1,24 @@
 """The tampering guard: a test during which the student's program impersonated the world
-or the grader on the graph is failed, not rewarded.
+or the grader on the graph is failed, not rewarded; one during which another user's
+program joined the grading's ROS domain is the grader's failure ("disturbed"), never
+blamed on the student.
 
 A :class:`GraphWatch` looks at the probe's graph every ``WATCH_EVERY`` wall seconds, from
 a thread of its own, for as long as the module's probe lives, and keeps when it saw each
 finding.  A test is charged with all that was seen since the previous test ended (the
 first test: since the probe started), so a foreign publisher that lives a fraction of a
 second inside a test fails that test, and one seen between two tests fails the next.
+
+Where runs share the machine's network (isolation by user, basic isolation) it also looks
+at the wire (:class:`Wire`): the UDP sockets bound to Fast DDS's ports, each with the user
+who made it. A socket on this grading's domain made by a user that is neither the
+grader's nor the student's is a stranger's; one the student's own user made on another
+domain's ports is the student joining another grading.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import threading
 import time
 from collections.abc import Callable, Iterator
@@ -17,7 +26,7 @@ from typing import TYPE_CHECKING, Any
 
 import pytest
 
-from autograder.core.errors import StudentFailure
+from autograder.core.errors import GraderError, StudentFailure
 from autograder.i18n import _
 from autograder.plugin.probe import GRADER_NODES
 from autograder.plugin.stash import settings_key
@@ -30,8 +39,32 @@ WORLD_TOPICS = ("/clock", "/odom", "/scan")
 # Wall seconds between two looks: a publisher that lives 0.3 s is seen about ten times.
 WATCH_EVERY = 0.025
 
-# A finding: ("publishes", node, topic) or ("named", name, "").
+# A finding: ("publishes", node, topic), ("named", name, ""), ("wanders", domain, "")
+# (the student's), or ("stranger", user, domain) (a disturbance, not the student's).
 Finding = tuple[str, str, str]
+
+
+@dataclasses.dataclass(frozen=True)
+class Wire:
+    """Who may have sockets on this test module's ROS domain: the grader's users and the
+    student's (``students``: the users of the grading's other modules too, the same
+    student's program); ``read`` lists the machine's (domain, user) sockets."""
+
+    domain: int
+    grader: frozenset[int]
+    student: int
+    read: Callable[[], list[tuple[int, int]]]
+    students: frozenset[int] = frozenset()
+
+    def look(self) -> list[Finding]:
+        found = set()
+        ours = self.grader | self.students | {self.student}
+        for domain, uid in self.read():
+            if domain == self.domain and uid not in ours:
+                found.add(("stranger", str(uid), str(domain)))
+            elif domain != self.domain and uid == self.student and uid not in self.grader:
+                found.add(("wanders", str(domain), ""))
+        return sorted(found)
 
 
 def _publishing(node: Any) -> list[Finding]:
@@ -49,6 +82,12 @@ def _named_twice(node: Any) -> list[Finding]:
 
 def _describe(finding: Finding) -> str:
     kind, node, topic = finding
+    if kind == "stranger":
+        return _("a program of another user (uid {uid}) joined this grading's ROS domain "
+                 "{domain}").format(uid=node, domain=topic)
+    if kind == "wanders":
+        return _("your program joined ROS domain {domain}, which is not its own").format(
+            domain=node)
     if kind == "publishes":
         return _("node '{node}' publishes on {topic}, which the simulator owns").format(
             node=node, topic=topic)
@@ -65,8 +104,10 @@ class GraphWatch:
     :meth:`stop`) and keeps, for each finding, the spans of time it was seen in."""
 
     def __init__(self, probe: Probe, every: float = WATCH_EVERY,
-                 clock: Callable[[], float] = time.monotonic) -> None:
+                 clock: Callable[[], float] = time.monotonic,
+                 wire: Wire | None = None) -> None:
         self._probe = probe
+        self._wire = wire
         self._every = every
         self._clock = clock
         self._lock = threading.Lock()
@@ -108,6 +149,8 @@ class GraphWatch:
         """Look at the graph once and note the time of what is there."""
         with self._looking:
             found = set(self._publishing() + _named_twice(self._probe.node))
+            if self._wire is not None:
+                found.update(self._wire.look())
             with self._lock:  # stamped under the lock: a look is before or after a charge
                 now = self._clock()
                 for finding in found:
@@ -137,14 +180,20 @@ class GraphWatch:
             return {f: [(a, b) for a, b in spans] for f, spans in self._spans.items()}
 
     def charge(self) -> list[str]:
-        """After a look, what was seen since the last charge (or the start), in words, in
-        the order first seen; later charges start from now."""
+        """After a look, what of the student's was seen since the last charge (or the
+        start), in words, in the order first seen; later charges start from now."""
+        return self.charge_split()[0]
+
+    def charge_split(self) -> tuple[list[str], list[str]]:
+        """:meth:`charge`, and besides what strangers did meanwhile (disturbances)."""
         self.look()
         with self._lock:
             since, self._charged = self._charged, self._clock()
             due = [(min(a for a, b in spans if b >= since), f)
                    for f, spans in self._spans.items() if any(b >= since for _a, b in spans)]
-        return [_describe(f) for _first, f in sorted(due)]
+        due.sort()
+        return ([_describe(f) for _first, f in due if f[0] != "stranger"],
+                [_describe(f) for _first, f in due if f[0] == "stranger"])
 
 
 # On a test module: the watch started with its probe (plugin/world.py).
@@ -173,10 +222,14 @@ def _graph_guard(request: pytest.FixtureRequest) -> Iterator[None]:
         watch.start()
     try:
         yield
-        seen = watch.charge()
+        seen, strangers = watch.charge_split()
     finally:
         if own:
             watch.stop()
+    if strangers:  # whatever the student did meanwhile: this test proves nothing
+        raise GraderError(_(
+            "Disturbed: {what}. This grading cannot be trusted; grade again.").format(
+            what="; ".join(strangers)))
     if seen:
         raise StudentFailure(
             _("Tampering with the simulated world: {what}. Tests run while it happens are "

@@ -13,7 +13,7 @@ import pytest
 
 from autograder.core.errors import StudentFailure
 from autograder.plugin.bag import attach_probe, close_bag, open_bag
-from autograder.plugin.guard import GraphWatch, graph_watch_key
+from autograder.plugin.guard import GraphWatch, Wire, graph_watch_key
 from autograder.plugin.probe import WORLD_NODE_NAME
 from autograder.plugin.stash import reporter_key, settings_key, type_watch_key
 from autograder.plugin.timing import Timing
@@ -22,6 +22,7 @@ if TYPE_CHECKING:
     from rclpy.context import Context
 
     from autograder.core.exercise import Exercise
+    from autograder.core.settings import RunSettings
     from autograder.plugin.probe import Probe
     from sim.bridge import SimBridge
     from sim.worldfile import WorldSpec
@@ -137,6 +138,22 @@ def _make_world(exercise: Exercise, spec: WorldSpec, ros_context: Context,
                      cmd_vel_type=exercise.cmd_vel_type)
 
 
+def _wire(settings: RunSettings) -> Wire | None:
+    """Who may be on this grading's domain, where runs share the network; None in strict
+    isolation (a network namespace of its own: nobody else is there)."""
+    from autograder.sandbox.domains import bound_on_domains
+    from autograder.sandbox.isolation import student_uid
+
+    domain = int(os.environ["ROS_DOMAIN_ID"])
+    if settings.strict:
+        return None
+    if not settings.own_user:  # the student is the grader's user
+        return Wire(domain, frozenset({os.getuid(), os.geteuid()}), os.getuid(),
+                    bound_on_domains)
+    return Wire(domain, frozenset({os.getuid(), os.geteuid()}), student_uid(domain),
+                bound_on_domains, frozenset(student_uid(d) for d in settings.domains))
+
+
 @pytest.fixture(scope="module")
 def probe(request: pytest.FixtureRequest, ros_context: Context,
           world: SimBridge) -> Iterator[Probe]:
@@ -150,7 +167,7 @@ def probe(request: pytest.FixtureRequest, ros_context: Context,
     # For the reporter: what the graph showed of types that never match (msgtypes.py).
     request.node.stash[type_watch_key] = node.types
     # For the tampering guard: the graph, watched from now until the probe goes.
-    watch = GraphWatch(node)
+    watch = GraphWatch(node, wire=_wire(request.config.stash[settings_key]))
     watch.start()
     request.node.stash[graph_watch_key] = watch
     try:

@@ -20,6 +20,7 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import fcntl
+import functools
 import os
 import stat
 import tempfile
@@ -125,6 +126,46 @@ def busy_on_the_wire(domain: int, tables: Iterable[str] = ("/proc/net/udp",
             if len(fields) > 1 and low <= int(fields[1].rsplit(":", 1)[1], 16) < low + DOMAIN_GAIN:
                 return True
     return False
+
+
+@functools.cache
+def ephemeral_low(path: str = "/proc/sys/net/ipv4/ip_local_port_range") -> int:
+    """The first port the kernel hands out to sockets bound to none (Linux: 32768)."""
+    try:
+        return int(Path(path).read_text().split()[0])
+    except (OSError, ValueError, IndexError):
+        return 32768
+
+
+def domain_of_port(port: int) -> int | None:
+    """The ROS domain whose Fast DDS ports hold ``port``; None outside them, and None for
+    a port the kernel may have handed out to any socket (Fast DDS's own sending sockets
+    among them), where a domain's ports cannot be told apart: gradings' domains
+    (``FIRST_DOMAIN`` to ``LAST_DOMAIN``) lie below."""
+    if port < PORT_BASE or port >= ephemeral_low():
+        return None
+    domain = (port - PORT_BASE) // DOMAIN_GAIN
+    return domain if domain <= 232 else None
+
+
+def bound_on_domains(tables: Iterable[str] = ("/proc/net/udp", "/proc/net/udp6"),
+                     ) -> list[tuple[int, int]]:
+    """Every UDP socket bound on this machine (this network namespace) to a port of a ROS
+    domain: (domain, the socket's user). The kernel keeps the user who made each socket,
+    so who is on a domain can be told without reading another user's processes."""
+    found = []
+    for table in tables:
+        try:
+            lines = Path(table).read_text().splitlines()[1:]
+        except OSError:
+            continue
+        for line in lines:
+            fields = line.split()
+            if len(fields) > 7:
+                domain = domain_of_port(int(fields[1].rsplit(":", 1)[1], 16))
+                if domain is not None:
+                    found.append((domain, int(fields[7])))
+    return found
 
 
 TAKEN = -1  # another run holds the lock

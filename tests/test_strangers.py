@@ -1,0 +1,146 @@
+"""Other users cannot spoil a grading, and a student cannot spoil another's (issue 29).
+
+Where runs share the machine's network (isolation by user: Gradescope's container, a pod
+grading several students at once), a program can join another grading's ROS domain. The
+grader tells who is on its domain from the sockets bound to the domain's Fast DDS ports,
+each kept with the user who made it: a stranger's disturbs the grading (the grader's
+failure, never the student's zero); the student's own on another domain's ports fails its
+own grading."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+from conftest import modes_kept
+
+from autograder.core.exercise import find_exercise
+from autograder.grading.run import grade
+from autograder.sandbox.domains import hold_domain
+
+pytestmark = [
+    pytest.mark.slow,
+    pytest.mark.skipif(os.geteuid() != 0 or not shutil.which("setpriv"),
+                       reason="needs root and setpriv to run programs as other users"),
+]
+
+COURSE = Path(__file__).parent / "fixtures" / "mini_course"
+CORPUS = Path(__file__).parent / "submissions" / "hostile"
+NOBODY = 65534
+
+
+@pytest.fixture
+def shout(monkeypatch: pytest.MonkeyPatch):
+    """The mini course's exercise, graded in isolation by user (root, no namespaces)."""
+    monkeypatch.setenv("AUTOGRADER_COURSE", str(COURSE))
+    monkeypatch.setenv("AUTOGRADER_ISOLATION", "user")
+    from autograder.sandbox import isolation
+
+    isolation.detect.cache_clear()
+    with modes_kept(isolation.protected_paths(COURSE)):
+        yield find_exercise("shout")
+    isolation.detect.cache_clear()
+
+
+def _participant(domain: int, code: str, uid: int | None = None) -> subprocess.Popen:
+    """A program with an rclpy participant on ``domain`` (as ``uid``, if given)."""
+    env = {"PATH": os.environ.get("PATH", ""), "ROS_DOMAIN_ID": str(domain),
+           "HOME": "/tmp", "ROS_LOG_DIR": "/tmp", "PYTHONUNBUFFERED": "1"}
+    command = [sys.executable, "-I", "-c", textwrap.dedent(code)]
+    if uid is not None:
+        command = ["setpriv", f"--reuid={uid}", f"--regid={uid}", "--clear-groups", *command]
+    return subprocess.Popen(command, env=env, cwd="/", stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, text=True)
+
+
+def _stop(process: subprocess.Popen) -> str:
+    process.kill()
+    output, _ = process.communicate(timeout=30)
+    return output
+
+
+IDLE = """
+    import rclpy, time
+    rclpy.init()
+    node = rclpy.create_node("another_grading")
+    print("UP", flush=True)
+    time.sleep(600)
+"""
+
+# Joins every domain whose ports appear on the machine after it started, and publishes
+# junk there on the exercise's output topic.
+SPOILER = """
+    import time, rclpy
+    from rclpy.context import Context
+    from std_msgs.msg import String
+
+    def domains():
+        found = set()
+        for table in ("/proc/net/udp", "/proc/net/udp6"):
+            for line in open(table).read().splitlines()[1:]:
+                port = int(line.split()[1].rsplit(":", 1)[1], 16)
+                if port >= 7400 and (port - 7400) // 250 <= 232:
+                    found.add((port - 7400) // 250)
+        return found
+
+    before, joined = domains(), {}
+    print("WATCHING", flush=True)
+    end = time.monotonic() + 300
+    while time.monotonic() < end:
+        for domain in domains() - before - set(joined):
+            context = Context()
+            rclpy.init(context=context, domain_id=domain)
+            node = rclpy.create_node("spoiler", context=context)
+            joined[domain] = node.create_publisher(String, "shout", 10)
+            print("JOINED", domain, flush=True)
+        for publisher in joined.values():
+            publisher.publish(String(data="SPOILED"))
+        time.sleep(0.02)
+"""
+
+
+def _wait_for(process: subprocess.Popen, line: str) -> None:
+    assert process.stdout is not None
+    for got in process.stdout:  # ends at the program's end: a deadline of its own
+        if got.strip() == line:
+            return
+    raise AssertionError(f"the helper program ended before saying {line}")
+
+
+def test_a_student_who_joins_another_grading_fails_its_own(shout):
+    """Another grading runs on a domain of its own; the student's program joins it."""
+    with hold_domain() as other:
+        victim = _participant(other.domain, IDLE)
+        try:
+            _wait_for(victim, "UP")
+            result = grade(shout, CORPUS / "joins_other_domain")
+        finally:
+            _stop(victim)
+    assert result.data["isolation"]["mode"] == "user"
+    assert f"JOINED DOMAIN {other.domain}" in result.log
+    assert result.grader_error is None, result.grader_details
+    assert result.score < result.max_score
+    messages = "\n".join(t.message for t in result.tests)
+    assert f"your program joined ROS domain {other.domain}, which is not its own" in messages
+
+
+def test_a_stranger_on_the_domain_disturbs_the_grading_and_blames_nobody(shout):
+    """A program of another user joins the grading's domain and publishes junk on the
+    topic the tests read: the grading is the grader's failure, named as a disturbance,
+    and no test says the student tampered with anything."""
+    spoiler = _participant(0, SPOILER, uid=NOBODY)
+    try:
+        _wait_for(spoiler, "WATCHING")
+        result = grade(shout, COURSE / "assignments" / "shout" / "solution")
+    finally:
+        output = _stop(spoiler)
+    assert "JOINED" in output, output[-2000:]
+    assert result.grader_error is not None
+    assert f"a program of another user (uid {NOBODY}) joined this grading's ROS domain" \
+        in result.grader_details
+    assert "Tampering" not in "\n".join(t.message for t in result.tests)
