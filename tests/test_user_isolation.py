@@ -1,0 +1,42 @@
+"""Every exercise's reference keeps full marks in isolation by user (root without
+namespaces: Gradescope's container, a pod), as it does in strict isolation, and its
+grade is official (issue 29)."""
+
+from __future__ import annotations
+
+import os
+
+import pytest
+from conftest import modes_kept
+
+from autograder.core.course import course_root
+from autograder.core.exercise import list_exercises
+from autograder.grading.run import grade
+from autograder.sandbox import isolation
+
+pytestmark = [pytest.mark.slow,
+              pytest.mark.skipif(os.geteuid() != 0, reason="isolation by user needs root")]
+
+
+@pytest.fixture(scope="module", autouse=True)
+def by_user():
+    old = os.environ.get("AUTOGRADER_ISOLATION")
+    os.environ["AUTOGRADER_ISOLATION"] = "user"
+    isolation.detect.cache_clear()
+    with modes_kept(isolation.protected_paths(course_root())):
+        yield
+    if old is None:
+        os.environ.pop("AUTOGRADER_ISOLATION", None)
+    else:
+        os.environ["AUTOGRADER_ISOLATION"] = old
+    isolation.detect.cache_clear()
+
+
+@pytest.mark.parametrize("exercise", list_exercises(), ids=lambda e: e.id)
+def test_the_reference_keeps_full_marks(exercise):
+    result = grade(exercise, None)
+    assert result.data["isolation"]["mode"] == "user"
+    assert result.data["isolation"]["official"] is True
+    assert result.grader_error is None, result.grader_details
+    assert result.score == result.max_score, [(t.name, t.message) for t in result.tests
+                                              if not t.passed]
