@@ -2,8 +2,9 @@
 left their process group and cgroup (or ran where no cgroup could be made), and the SysV
 IPC objects, POSIX message queues and files in the shared scratch folders it made.
 
-Only for a user of the student's own (strict isolation gives each run one): never root,
-never the grader's user.  The kill is sent *as* that user, ``kill(-1, SIGKILL)``, which
+Only for a user of the student's own (strict isolation and isolation by user give each
+run one): never root, never the grader's user.  The kill is sent *as* that user,
+``kill(-1, SIGKILL)``, which
 the kernel delivers to every process the sender may signal (all of that user's, itself
 excepted) in one pass, so a program forking as fast as it can is not raced pid by pid.
 In strict isolation the program's IPC objects and ``/tmp`` are its own namespace's and go
