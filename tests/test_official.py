@@ -4,11 +4,16 @@ grading whose pytest process something stopped is the grader's failure, never a 
 
 from __future__ import annotations
 
+import os
+import shutil
 import signal
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
+
+import pytest
 
 from autograder.core.report import RawReport
 from autograder.grading import children
@@ -17,6 +22,10 @@ from autograder.render.terminal import isolation_line
 from autograder.sandbox.isolation import LOOPBACK_PROFILE, PROFILE_ENV, Isolation, dds_env
 
 BOUNDS = {"cgroup": None, "processes": "rlimit", "memory": "rlimit"}
+REPO = Path(__file__).resolve().parent.parent
+COURSE = REPO / "tests" / "fixtures" / "mini_course"
+CORPUS = REPO / "tests" / "submissions" / "hostile"
+NOBODY = 65534
 
 
 def test_only_a_user_of_its_own_gives_official_grades():
@@ -75,3 +84,38 @@ def test_a_stopped_grading_is_the_graders_failure(tmp_path):
             process.kill()
             process.wait()
     assert not Path(f"/proc/{process.pid}").exists() or process.returncode is not None
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(os.geteuid() != 0 or not shutil.which("setpriv"),
+                    reason="needs root and setpriv to grade as an ordinary user")
+def test_an_ordinary_users_grading_resists_a_program_that_stops_it(tmp_path):
+    """Graded as an ordinary user (basic isolation), a program finds the grading's pytest
+    process: it cannot open its memory (not dumpable), and stopping it makes the grading
+    the grader's failure (exit 3), never a verdict; the results say it is not official."""
+    work = Path(tempfile.mkdtemp(prefix="autograder-user-"))
+    try:
+        work.chmod(0o777)
+        course = work / "course"
+        shutil.copytree(COURSE, course)
+        submission = work / "submission"
+        shutil.copytree(CORPUS / "stops_the_grader", submission)
+        for path in [course, submission, *course.rglob("*"), *submission.rglob("*")]:
+            path.chmod(0o755 if path.is_dir() else 0o644)
+        env = {"PATH": os.environ.get("PATH", ""), "HOME": str(work), "LANG": "C.UTF-8",
+               "AUTOGRADER_COURSE": str(course), "XDG_CACHE_HOME": str(work / "cache")}
+        done = subprocess.run(
+            ["setpriv", f"--reuid={NOBODY}", f"--regid={NOBODY}", "--clear-groups",
+             str(Path(sys.executable).with_name("autograder")), "grade", "shout",
+             str(submission), "--results", str(work / "results.json")],
+            env=env, cwd=str(work), capture_output=True, text=True, timeout=600)
+        output = done.stdout + done.stderr
+        said = Path(f"/tmp/stops-the-grader-{NOBODY}.txt")
+        log = said.read_text() if said.exists() else ""
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+        Path(f"/tmp/stops-the-grader-{NOBODY}.txt").unlink(missing_ok=True)
+    assert "STOPPING" in log, output[-3000:]
+    assert "MEM OPENED" not in log and "MEM DENIED" in log
+    assert done.returncode == 3, output[-3000:]
+    assert "Not an official grade" in output

@@ -13,6 +13,7 @@ import os
 import shutil
 import subprocess
 import sys
+import tempfile
 import textwrap
 from pathlib import Path
 
@@ -47,10 +48,11 @@ def shout(monkeypatch: pytest.MonkeyPatch):
     isolation.detect.cache_clear()
 
 
-def _participant(domain: int, code: str, uid: int | None = None) -> subprocess.Popen:
+def _participant(domain: int, code: str, uid: int | None = None,
+                 env: dict[str, str] | None = None) -> subprocess.Popen:
     """A program with an rclpy participant on ``domain`` (as ``uid``, if given)."""
     env = {"PATH": os.environ.get("PATH", ""), "ROS_DOMAIN_ID": str(domain),
-           "HOME": "/tmp", "ROS_LOG_DIR": "/tmp", "PYTHONUNBUFFERED": "1"}
+           "HOME": "/tmp", "ROS_LOG_DIR": "/tmp", "PYTHONUNBUFFERED": "1", **(env or {})}
     command = [sys.executable, "-I", "-c", textwrap.dedent(code)]
     if uid is not None:
         command = ["setpriv", f"--reuid={uid}", f"--regid={uid}", "--clear-groups", *command]
@@ -144,3 +146,75 @@ def test_a_stranger_on_the_domain_disturbs_the_grading_and_blames_nobody(shout):
     assert f"a program of another user (uid {NOBODY}) joined this grading's ROS domain" \
         in result.grader_details
     assert "Tampering" not in "\n".join(t.message for t in result.tests)
+
+
+SUBSCRIBER = """
+    import os, socket, struct, time, rclpy
+    from std_msgs.msg import String
+    rclpy.init()
+    node = rclpy.create_node("student_side")
+    got = []
+    node.create_subscription(String, "loopback", lambda m: got.append(m.data), 10)
+    end = time.monotonic() + 30
+    while time.monotonic() < end and not got:
+        rclpy.spin_once(node, timeout_sec=0.1)
+    print("GOT" if got else "NOTHING", flush=True)
+    mine = set()  # this process's sockets, by inode
+    for fd in os.listdir("/proc/self/fd"):
+        try:
+            target = os.readlink(f"/proc/self/fd/{fd}")
+        except OSError:
+            continue
+        if target.startswith("socket:["):
+            mine.add(target[8:-1])
+    for table in ("/proc/net/udp", "/proc/net/udp6"):
+        for line in open(table).read().splitlines()[1:]:
+            fields = line.split()
+            if fields[9] in mine:
+                address = fields[1].rsplit(":", 1)[0]
+                if len(address) == 8:
+                    address = socket.inet_ntoa(struct.pack("<I", int(address, 16)))
+                print("BOUND", address, flush=True)
+"""
+
+PUBLISHER = """
+    import time, rclpy
+    from std_msgs.msg import String
+    rclpy.init()
+    node = rclpy.create_node("grader_side")
+    publisher = node.create_publisher(String, "loopback", 10)
+    print("UP", flush=True)
+    while True:
+        publisher.publish(String(data="hello"))
+        rclpy.spin_once(node, timeout_sec=0.05)
+"""
+
+
+def test_the_loopback_profile_talks_across_users_and_binds_nothing_else():
+    """Isolation by user's Fast DDS profile: root's participant and another user's talk,
+    and every socket the other user's participant binds is on 127.0.0.1 (or the
+    discovery multicast group, joined on loopback): no other interface is listened on."""
+    from autograder.sandbox.isolation import LOOPBACK_PROFILE, PROFILE_ENV
+
+    folder = Path(tempfile.mkdtemp(prefix="autograder-profile-"))  # readable by the user
+    folder.chmod(0o755)
+    profile = folder / "profile.xml"
+    profile.write_bytes(LOOPBACK_PROFILE.read_bytes())
+    profile.chmod(0o644)
+    extra = {PROFILE_ENV: str(profile)}
+    try:
+        with hold_domain() as lock:
+            grader = _participant(lock.domain, PUBLISHER, env=extra)
+            try:
+                _wait_for(grader, "UP")
+                student = _participant(lock.domain, SUBSCRIBER, uid=NOBODY, env=extra)
+                output, _ = student.communicate(timeout=120)
+            finally:
+                _stop(grader)
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
+    assert "GOT" in output.splitlines(), output
+    bound = [line.split()[1] for line in output.splitlines() if line.startswith("BOUND ")]
+    assert bound, output
+    for address in bound:
+        assert address == "127.0.0.1" or 224 <= int(address.split(".")[0]) <= 239, bound

@@ -37,7 +37,7 @@ TABLE: list[tuple[str, Cell, Cell, Cell]] = [
      ("another user, and out of sight", "test_the_machines_processes_are_out_of_sight_and_reach"),
      ("another user", "test_the_graders_processes_can_be_seen_but_not_stopped_or_traced"),
      ("memory and tracing closed (not dumpable); a stopped grading is the grader's failure",
-      "test_a_stopped_grading_is_the_graders_failure")),
+      "test_an_ordinary_users_grading_resists_a_program_that_stops_it")),
     ("a daemon that rewrites the results afterwards",
      ("ended with its user", "test_without_cgroups_a_daemon_still_ends_with_the_program"),
      ("ended with its user", "test_a_daemon_cannot_rewrite_the_results_and_nothing_is_left"),
