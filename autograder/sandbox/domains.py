@@ -111,11 +111,11 @@ def _open_lock(path: Path) -> int | None:
     return None
 
 
-def busy_on_the_wire(domain: int, tables: Iterable[str] = ("/proc/net/udp",
-                                                            "/proc/net/udp6")) -> bool:
-    """True if a UDP socket on this machine (this network namespace) is bound to one of
-    the domain's Fast DDS ports: someone is on that domain, locks or not."""
-    low = PORT_BASE + DOMAIN_GAIN * domain
+def udp_sockets(tables: Iterable[str] = ("/proc/net/udp", "/proc/net/udp6"),
+                ) -> list[tuple[int, int]]:
+    """Every UDP socket bound on this machine (this network namespace): (local port, the
+    user who made it, as the kernel keeps it)."""
+    found = []
     for table in tables:
         try:
             lines = Path(table).read_text().splitlines()[1:]
@@ -123,9 +123,17 @@ def busy_on_the_wire(domain: int, tables: Iterable[str] = ("/proc/net/udp",
             continue
         for line in lines:
             fields = line.split()
-            if len(fields) > 1 and low <= int(fields[1].rsplit(":", 1)[1], 16) < low + DOMAIN_GAIN:
-                return True
-    return False
+            if len(fields) > 7:
+                found.append((int(fields[1].rsplit(":", 1)[1], 16), int(fields[7])))
+    return found
+
+
+def busy_on_the_wire(domain: int, tables: Iterable[str] = ("/proc/net/udp",
+                                                            "/proc/net/udp6")) -> bool:
+    """True if a UDP socket on this machine (this network namespace) is bound to one of
+    the domain's Fast DDS ports: someone is on that domain, locks or not."""
+    low = PORT_BASE + DOMAIN_GAIN * domain
+    return any(low <= port < low + DOMAIN_GAIN for port, _uid in udp_sockets(tables))
 
 
 @functools.cache
@@ -153,19 +161,8 @@ def bound_on_domains(tables: Iterable[str] = ("/proc/net/udp", "/proc/net/udp6")
     """Every UDP socket bound on this machine (this network namespace) to a port of a ROS
     domain: (domain, the socket's user). The kernel keeps the user who made each socket,
     so who is on a domain can be told without reading another user's processes."""
-    found = []
-    for table in tables:
-        try:
-            lines = Path(table).read_text().splitlines()[1:]
-        except OSError:
-            continue
-        for line in lines:
-            fields = line.split()
-            if len(fields) > 7:
-                domain = domain_of_port(int(fields[1].rsplit(":", 1)[1], 16))
-                if domain is not None:
-                    found.append((domain, int(fields[7])))
-    return found
+    return [(domain, uid) for port, uid in udp_sockets(tables)
+            if (domain := domain_of_port(port)) is not None]
 
 
 TAKEN = -1  # another run holds the lock
