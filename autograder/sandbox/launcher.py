@@ -32,6 +32,7 @@ import json
 import os
 import resource
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 
 _RLIMITS = {
@@ -69,20 +70,25 @@ def apply_limits(limits: dict[str, int]) -> None:
     resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
 
 
-def user_tasks(uid: int, proc: str = "/proc") -> int:
-    """Processes and threads whose real user is ``uid`` now: what RLIMIT_NPROC counts."""
-    total = 0
+def process_statuses(proc: str = "/proc") -> Iterator[tuple[int, int, bytes, int]]:
+    """Every process now: (pid, real user, state letter, threads), from its ``status``;
+    one gone meanwhile, or a kernel thread's short status, is passed over."""
     for name in os.listdir(proc):
         if not name.isdigit():
             continue
         try:
             with open(f"{proc}/{name}/status", "rb") as fh:
                 fields = dict(line.split(b":", 1) for line in fh if b":" in line)
-            if int(fields[b"Uid"].split()[0]) == uid:
-                total += int(fields[b"Threads"])
+            yield (int(name), int(fields[b"Uid"].split()[0]), fields.get(b"State", b"").strip()[:1],
+                   int(fields[b"Threads"]))
         except (OSError, KeyError, ValueError, IndexError):
-            continue  # gone meanwhile, or a kernel thread's short status
-    return total
+            continue
+
+
+def user_tasks(uid: int, proc: str = "/proc") -> int:
+    """Processes and threads whose real user is ``uid`` now: what RLIMIT_NPROC counts."""
+    return sum(threads for _pid, owner, _state, threads in process_statuses(proc)
+               if owner == uid)
 
 
 def _libc() -> ctypes.CDLL:

@@ -21,6 +21,8 @@ import subprocess
 import sys
 import time
 
+from autograder.sandbox.launcher import process_statuses
+
 _KILL_ALL = "import os, signal; os.kill(-1, signal.SIGKILL)"
 
 STUDENT_UID_BASE = 200_000
@@ -35,19 +37,8 @@ def is_student_uid(uid: int) -> bool:
 
 def user_processes(uid: int, proc: str = "/proc") -> list[int]:
     """The live processes (not zombies) whose real user is ``uid``."""
-    found = []
-    for name in os.listdir(proc):
-        if not name.isdigit():
-            continue
-        try:
-            with open(f"{proc}/{name}/status", "rb") as fh:
-                fields = dict(line.split(b":", 1) for line in fh if b":" in line)
-            if int(fields[b"Uid"].split()[0]) == uid and not fields[b"State"].strip(
-                    ).startswith(b"Z"):
-                found.append(int(name))
-        except (OSError, KeyError, ValueError, IndexError):
-            continue  # gone meanwhile
-    return found
+    return [pid for pid, owner, state, _threads in process_statuses(proc)
+            if owner == uid and state != b"Z"]
 
 
 def kill_user(uid: int, timeout: float = 5.0) -> bool:
