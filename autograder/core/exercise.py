@@ -51,6 +51,9 @@ class Exercise:
         "Total points; must equal the sum of the tests' points (0: not checked)."))
     pass_mark: float = dataclasses.field(default=0.7, metadata=_doc(
         "Fraction of the points needed to pass."))
+    core: tuple[str, ...] = dataclasses.field(default=(), metadata=_doc(
+        "Names of the core tests: the chapter's central idea and the robot's safety. A "
+        "grading passes only with every one of them passed and the points at the pass mark."))
     world: str = dataclasses.field(default="empty_room", metadata=_doc(
         "World the tests run in: a name under sim/worlds or a path relative to the exercise."))
     cmd_vel_type: Literal["Twist", "TwistStamped"] | None = dataclasses.field(
@@ -83,6 +86,8 @@ class Exercise:
     def __post_init__(self) -> None:
         if not 0 < self.pass_mark <= 1:
             raise ValueError(_("pass_mark must be above 0 and at most 1"))
+        if len(set(self.core)) != len(self.core):
+            raise ValueError(_("core names a test more than once"))
 
     @property
     def localized_title(self) -> str:

@@ -58,6 +58,8 @@ class TestResult:
     reveal: Reveal = "message"
     details: str = ""
     data: dict[str, Any] = dataclasses.field(default_factory=dict)
+    # A core test (exercise.yaml's ``core``): without it passed, the grading does not pass.
+    core: bool = False
 
     def __post_init__(self) -> None:
         # What a test says may quote a program's output: every format shows it harmless.
@@ -170,11 +172,17 @@ class RunResult:
         return self.score / self.max_score if self.max_score else Fraction(0)
 
     @property
+    def core_missed(self) -> tuple[TestResult, ...]:
+        """The core tests that did not pass: each alone keeps the grading from passing,
+        whatever the points."""
+        return tuple(t for t in self.tests if t.core and not t.passed)
+
+    @property
     def passed(self) -> bool:
-        """At or above the pass mark, compared exactly; never when the grader failed, nor
-        for a partial run (see :attr:`complete`)."""
+        """At or above the pass mark, compared exactly, with every core test passed; never
+        when the grader failed, nor for a partial run (see :attr:`complete`)."""
         return self.complete and self.grader_error is None and self.max_score > 0 and \
-            self.fraction >= self.pass_mark
+            self.fraction >= self.pass_mark and not self.core_missed
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> RunResult:
@@ -185,7 +193,7 @@ class RunResult:
                        score=exact(t["score"]), max_score=exact(t["max_score"]),
                        status=t["status"], message=t.get("message", ""),
                        hint=t.get("hint", ""), visibility=t.get("visibility", "visible"),
-                       reveal=t.get("reveal", "message"))
+                       reveal=t.get("reveal", "message"), core=t.get("core", False))
             for t in data["tests"])
         return cls(kind=kind, id=data[kind], title=data.get("title", ""), tests=tests,
                    pass_mark=exact(data.get("pass_mark", "0.7")), lang=data.get("lang", "en"),
@@ -205,6 +213,8 @@ class RunResult:
             "passed": self.passed if self.complete else None,
             **({"not_run": self.not_run.to_dict()} if self.not_run is not None else {}),
             "pass_mark": number(self.pass_mark),
+            # The core tests that did not pass (each keeps the grading from passing).
+            "core_missed": [t.name for t in self.core_missed],
             "lang": self.lang,
             "grader_error": self.grader_error,
             "execution_time": round(self.execution_time, 3),
@@ -229,6 +239,7 @@ class RunResult:
                     "hint": t.hint,
                     "visibility": t.visibility,
                     "reveal": t.reveal,
+                    "core": t.core,
                 }
                 for t in self.tests
             ],

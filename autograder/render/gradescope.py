@@ -8,6 +8,7 @@ from typing import Any
 from autograder.core.results import RunResult, TestResult, number
 from autograder.i18n import _
 from autograder.render import OutputFormat
+from autograder.render.verdict import core_label, core_lines
 
 # Gradescope's visibility values; our "hidden" tests follow the exercise's setting.
 _VISIBILITY = {"visible": "visible", "hidden": "hidden", "after_published": "after_published"}
@@ -26,6 +27,8 @@ def to_gradescope_dict(result: RunResult) -> dict[str, Any]:
         mark=number(result.pass_mark * 100))
     if result.grader_error:
         summary += "\n" + _("The autograder failed, tell your instructor.")
+    elif result.core_missed:
+        summary += "\n" + "\n".join(core_lines(result))
     return {
         "score": number(result.score),
         "execution_time": round(result.execution_time),
@@ -34,7 +37,7 @@ def to_gradescope_dict(result: RunResult) -> dict[str, Any]:
         "stdout_visibility": "hidden",
         "tests": [
             {
-                "name": test.label,
+                "name": core_label(test),
                 "name_format": "text",
                 "number": str(index),
                 "score": number(test.score),

@@ -19,15 +19,21 @@ from autograder.quiz.localize import Text, format_percent, using_language
 from autograder.quiz.render import environment
 from autograder.render import OutputFormat, replay
 from autograder.render.charts import intervals_svg
+from autograder.render.verdict import core_heading, core_label
 
 
 def to_html(result: RunResult, exercise_folder: Path | None = None) -> str:
-    lang = result.lang
+    with using_language(lang := result.lang):
+        return _render(result, _tests(result, lang), exercise_folder)
+
+
+def _tests(result: RunResult, lang: str) -> list[dict[str, Any]]:
+    """Each test as the template shows it (in the active language: a core test's mark)."""
     tests = []
     for test in result.tests:
         tests.append({
             "test": test,
-            "label": Text(test.label, lang),
+            "label": Text(core_label(test), lang),
             "message": Text(test.student_message, lang) if test.student_message else None,
             "hint": Text(test.student_hint, lang) if test.student_hint else None,
             "charts": [{"svg": intervals_svg([tuple(p) for p in chart["points"]],
@@ -36,8 +42,7 @@ def to_html(result: RunResult, exercise_folder: Path | None = None) -> str:
                        for chart in test.data.get("charts", []) if chart.get("points")],
             "score": number(test.score), "max_score": number(test.max_score),
         })
-    with using_language(lang):
-        return _render(result, tests, exercise_folder)
+    return tests
 
 
 def _render(result: RunResult, tests: list[dict[str, Any]], exercise_folder: Path | None) -> str:
@@ -50,6 +55,8 @@ def _render(result: RunResult, tests: list[dict[str, Any]], exercise_folder: Pat
         score=number(result.score), max_score=number(result.max_score),
         percent=format_percent(result.fraction, lang),
         pass_mark=format_percent(result.pass_mark, lang),
+        core_heading=core_heading(result),
+        core_missed=[Text(t.label, lang) for t in result.core_missed],
         pictures=pictures,
         script=script if any(p.replay for p in pictures) else None, script_hash=script_hash)
 

@@ -7,6 +7,7 @@ import xml.etree.ElementTree as ET
 from autograder.core.results import RunResult, number
 from autograder.core.untrusted import visible
 from autograder.render import OutputFormat
+from autograder.render.verdict import core_label, core_note
 
 
 def to_junit(result: RunResult) -> str:
@@ -25,6 +26,7 @@ def to_junit(result: RunResult) -> str:
         ("complete", "false")
     for name, value in (("score", number(result.score)), ("max_score", number(result.max_score)),
                         verdict, ("pass_mark", number(result.pass_mark)),
+                        ("core_missed", " ".join(t.name for t in result.core_missed)),
                         ("lang", result.lang)):
         ET.SubElement(properties, "property", {"name": name, "value": str(value)})
     for test in result.tests:
@@ -32,11 +34,13 @@ def to_junit(result: RunResult) -> str:
             "classname": f"{result.id}.{test.visibility}", "name": test.name,
             "time": "0"})
         ET.SubElement(case, "properties").extend([
-            ET.Element("property", {"name": "label", "value": test.label}),
+            ET.Element("property", {"name": "label", "value": core_label(test)}),
+            ET.Element("property", {"name": "core", "value": str(test.core).lower()}),
             ET.Element("property", {"name": "score", "value": str(number(test.score))}),
             ET.Element("property", {"name": "max_score", "value": str(number(test.max_score))}),
         ])
-        text = "\n".join(p for p in (test.message, test.hint) if p)
+        text = "\n".join(p for p in (test.message, test.hint,
+                                     core_note() if test.core else "") if p)
         if test.status == "failed":
             ET.SubElement(case, "failure", {"message": _first_line(test.message)}).text = text
         elif test.status == "error":

@@ -20,6 +20,7 @@ from babel.numbers import format_percent
 
 from autograder.core.results import RunResult, TestResult, as_decimal, number
 from autograder.i18n import _, get_language, is_rtl, ngettext
+from autograder.render.verdict import core_label, core_lines
 
 RLM = "\u200f"
 _ANSI = re.compile(r"\x1b\[[0-9;]*[A-Za-z]")
@@ -95,7 +96,7 @@ def test_line(test: TestResult, color: bool = False) -> str:
     in :func:`failure_blocks`)."""
     mark, tint = _MARKS[test.status]
     points = f"{number(test.score)}/{number(test.max_score)}"
-    return for_terminal(f" {_style(mark, tint, color)} {points:>5}  {test.label}")
+    return for_terminal(f" {_style(mark, tint, color)} {points:>5}  {core_label(test)}")
 
 
 def _indented(text: str) -> list[str]:
@@ -136,12 +137,20 @@ def score_lines(result: RunResult, color: bool = False) -> list[str]:
     if result.not_run is not None:
         line = _("Public tests: {score}/{max_score} ({percent}).").format(
             score=score, max_score=max_score, percent=percent)
-        return [_style(line, None, color, bold=True), result.not_run.describe()]
+        return [_style(line, None, color, bold=True), result.not_run.describe(),
+                *_core_missed(result, color)]
     mark = format_percent(as_decimal(result.pass_mark), locale=result.lang)
     verdict = _("passed") if result.passed else _("not passed")
     line = _("Score: {score}/{max_score} ({percent}), {verdict} (pass mark {mark})").format(
         score=score, max_score=max_score, percent=percent, verdict=verdict, mark=mark)
-    return [_style(line, "green" if result.passed else "red", color, bold=True)]
+    return [_style(line, "green" if result.passed else "red", color, bold=True),
+            *_core_missed(result, color)]
+
+
+def _core_missed(result: RunResult, color: bool) -> list[str]:
+    """The core tests that kept the grading from passing, under a line saying so."""
+    lines = core_lines(result)
+    return [_style(lines[0], "red", color, bold=True), *lines[1:]] if lines else []
 
 
 def _bound(kind: str | None, cgroup: str | None, controller: str, rlimit: str) -> str:
