@@ -302,7 +302,8 @@ def _result(exercise: Exercise, raw_report: RawReport, ended: Sequence[children.
                 seconds=exercise.time_limit))
         if test.status == "error":
             errors.append(f"{raw.name}: {test.message}\n{raw.details}")
-        tests.append(test)
+        # exercise.yaml names the core tests: the grader marks them, not the child's report.
+        tests.append(dataclasses.replace(test, core=raw.name in exercise.core))
     grader_error = None
     details = ""
     broken = [e for e in ended if e.broken]  # e.g. a test file that does not import
