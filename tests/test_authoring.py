@@ -67,7 +67,25 @@ def test_a_failing_reference_and_a_passing_starter_are_caught(course):
     (folder / "starter" / "shouter.py").write_text(solution)
     problems = [str(p) for p in validate(course)]
     assert any("the reference solution scores 2/3" in p for p in problems), problems
+    assert any("the reference solution fails core tests: test_upper_case" in p
+               for p in problems), problems
     assert any("the starter scores 3/3, at or above the pass mark" in p for p in problems)
+    assert any("the starter passes every core test (test_upper_case)" in p for p in problems)
+
+
+def test_core_tests_must_be_named_and_exist(course):
+    path = shout(course) / "exercise.yaml"
+    text = path.read_text()
+    path.write_text(text.replace("core: [test_upper_case]",
+                                 "core:\n  - test_upper_case\n  - test_uper_case"))
+    problems = [str(p) for p in validate(course, run_gradings=False)]
+    line = text.splitlines().index("core: [test_upper_case]") + 3
+    assert any(p.startswith(f"{path}:{line}: core.1: no test named 'test_uper_case'")
+               for p in problems), problems
+    assert not any("'test_upper_case'" in p for p in problems), problems
+    path.write_text(text.replace("core: [test_upper_case]\n", ""))
+    problems = [str(p) for p in validate(course, run_gradings=False)]
+    assert any(p.startswith(f"{path}:") and "core names no test" in p for p in problems)
 
 
 def test_malformed_exercise_file_names_file_line_and_field(course):

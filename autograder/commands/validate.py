@@ -1,6 +1,7 @@
 """Check a whole course tree before a release: every exercise file loads, its files exist,
-its worlds load, its reference solution scores 100%, its starter scores below the pass
-mark, and every quiz lints.  Each problem is a ``file:line: message``."""
+its worlds load, its core tests exist, its reference solution scores 100% (every core test
+passed), its starter does not pass (and fails a core test), and every quiz lints.  Each
+problem is a ``file:line: message``."""
 
 from __future__ import annotations
 
@@ -10,7 +11,7 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 from autograder.core.errors import ContentError
-from autograder.core.exercise import Exercise, assignments_dir, load_exercise
+from autograder.core.exercise import Exercise, assignments_dir, load_exercise, test_names
 from autograder.core.results import RunResult, number
 from autograder.i18n import _
 from autograder.i18n.tools import Problem
@@ -33,6 +34,19 @@ def _files(exercise: Exercise) -> list[Problem]:
             problems.append(Problem(where, None, _("{what} {path} is missing").format(
                 what=what, path=path)))
     return problems
+
+
+def _core(exercise: Exercise) -> list[Problem]:
+    """The exercise names core tests, and each is one of its tests."""
+    doc = load_document(exercise.folder / "exercise.yaml")
+    if not exercise.core:
+        return [Problem(doc.path, None, _(
+            "core names no test: name the tests without which the exercise is not passed "
+            "(the chapter's central idea, the robot's safety)"))]
+    known = test_names(exercise)
+    return [_from(doc.error(_("no test named {name!r} in {folder}").format(
+                name=name, folder=exercise.folder / "tests"), "core", index))
+            for index, name in enumerate(exercise.core) if name not in known]
 
 
 def _worlds(exercise: Exercise) -> list[Problem]:
@@ -68,11 +82,19 @@ def _gradings(exercise: Exercise, grade: Callable[..., RunResult]) -> list[Probl
             "the reference solution scores {score}/{max_score}, not full marks (failed: "
             "{failed})").format(score=number(reference.score),
                                 max_score=number(reference.max_score), failed=failed)))
+    if reference.grader_error is None and reference.core_missed:
+        problems.append(Problem(where, None, _(
+            "the reference solution fails core tests: {failed}").format(
+            failed=", ".join(t.name for t in reference.core_missed))))
     starter = grade(exercise, exercise.starter)
     if starter.grader_error is None and starter.passed:
         problems.append(Problem(where, None, _(
             "the starter scores {score}/{max_score}, at or above the pass mark").format(
             score=number(starter.score), max_score=number(starter.max_score))))
+    if starter.grader_error is None and exercise.core and not starter.core_missed:
+        problems.append(Problem(where, None, _(
+            "the starter passes every core test ({tests}): a core test should need the "
+            "student's work").format(tests=", ".join(exercise.core))))
     return problems
 
 
@@ -94,7 +116,7 @@ def validate(root: Path | None = None, *, run_gradings: bool = True, jobs: int =
         except ContentError as exc:
             problems.append(_from(exc))
             continue
-        found = _files(exercise) + _worlds(exercise)
+        found = _files(exercise) + _worlds(exercise) + _core(exercise)
         problems += found
         if not found:
             exercises.append(exercise)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import ast
 import dataclasses
 from fractions import Fraction
 from pathlib import Path
@@ -113,6 +114,20 @@ class Exercise:
     @property
     def solution(self) -> Path:
         return self.folder / "solution" / self.file
+
+
+def test_names(exercise: Exercise) -> frozenset[str]:
+    """The names of the exercise's test functions, public and hidden (read, not imported)."""
+    names: set[str] = set()
+    for path in sorted(exercise.folder.glob("tests/**/test_*.py")):
+        try:
+            tree = ast.parse(path.read_text(encoding="utf-8"))
+        except SyntaxError:
+            continue
+        names.update(node.name for node in ast.walk(tree)
+                     if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef)
+                     and node.name.startswith("test"))
+    return frozenset(names)
 
 
 def assignments_dir() -> Path:
