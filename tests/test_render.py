@@ -215,3 +215,55 @@ def test_the_results_file_reads_back_with_its_timing_memory_and_pacing():
     again = RunResult.from_dict(written)
     assert again.data == data
     assert json.loads(to_json(again)) == written
+
+
+def core_missed(lang: str = "en") -> RunResult:
+    """At the pass mark on points (9/10), but its one core test failed."""
+    tests = (
+        TestResult("test_refuses", "Refuses bad values", Fraction(0), Fraction(1), "failed",
+                   message="accepted 3.0", core=True),
+        TestResult("test_clamps", "Clamps linear.x", Fraction(9), Fraction(9), "passed",
+                   core=True),
+    )
+    return RunResult("exercise", "parameter_validation", "A governor", tests, lang=lang)
+
+
+@pytest.mark.parametrize("lang,headline,core_mark", [
+    ("en", "Not passed: this core test failed", "Refuses bad values (core)"),
+    ("ur", "کامیاب نہیں: یہ بنیادی test ناکام ہوا", "Refuses bad values (بنیادی)"),
+])
+def test_every_format_names_the_core_test_that_kept_it_from_passing(lang, headline,
+                                                                     core_mark):
+    set_language(lang)
+    run = core_missed(lang)
+    assert run.fraction >= run.pass_mark and not run.passed
+    data = json.loads(to_json(run))
+    assert (data["passed"], data["core_missed"]) == (False, ["test_refuses"])
+    assert [t["core"] for t in data["tests"]] == [True, True]
+    assert RunResult.from_dict(data).core_missed[0].name == "test_refuses"
+    terminal = to_terminal(run)
+    assert headline in terminal and core_mark in terminal
+    # The core test that failed is named after the verdict; the one that passed is not.
+    after = terminal[terminal.index(headline):]
+    assert "Refuses bad values" in after and "Clamps linear.x" not in after
+    gradescope = to_gradescope_dict(run)
+    assert headline in gradescope["output"] and "- Refuses bad values" in gradescope["output"]
+    assert gradescope["tests"][0]["name"] == core_mark
+    suite = ET.fromstring(to_junit(run)).find("testsuite")
+    properties = {p.get("name"): p.get("value") for p in suite.find("properties")}
+    assert (properties["passed"], properties["core_missed"]) == ("false", "test_refuses")
+    assert suite.find("testcase/failure").text.endswith(
+        "whatever the points." if lang == "en" else "کامیاب نہیں ہوتی۔")
+    page = to_html(run)
+    box = page[page.index('id="core-missed"'):]
+    box = re.sub(r"<[^>]+>", "", box[:box.index("</div>")])  # the words, without bidi tags
+    assert headline in box and "Refuses bad values" in box
+
+
+def test_a_grading_with_every_core_test_passed_says_nothing_of_them():
+    run = core_missed()
+    run = dataclasses.replace(run, tests=(dataclasses.replace(run.tests[0], core=False),
+                                          run.tests[1]))
+    assert run.passed and not run.core_missed
+    assert "core test" not in to_terminal(run) and 'id="core-missed"' not in to_html(run)
+    assert json.loads(to_json(run))["core_missed"] == []
