@@ -176,12 +176,12 @@ def _run(exercise: str, submission: Path, hidden: bool, outputs: dict[str, Path 
     from autograder.render.terminal import for_terminal, heading, rtl_notice, to_terminal
 
     found = _exercise(exercise)
-    if require_official:
-        refuse_unofficial("--no-require-official")
-    try:
-        check(submission, found.file)  # a link, device or FIFO: the student's clear error
+    try:  # a link, a FIFO, not a node Python runs: the student's error, said first
+        check(submission, found.file)
     except SubmissionNotFound as exc:
         raise UsageProblem(str(exc)) from None
+    if require_official:
+        refuse_unofficial("--no-require-official")
     color, in_place = terminal_style(sys.stdout)
     # Every test line once, on stdout as the tests end; the summary after them adds the
     # failures and the score (and the lines of tests that never ended).

@@ -21,11 +21,7 @@ def test_reference_max_score_is_the_exercise_points(graded):
     assert graded["reference#0"].max_score == 13
 
 
-def test_syntax_error_is_named_with_its_line(graded):
-    result = graded["syntax_error"]
-    assert result.grader_error is None, explain(**diagnosis(result))
-    assert result.score == 0
-    assert all("velocity_governor.py, line" in t.message for t in result.tests)
+# A syntax error is refused before any world starts: tests/test_source.py.
 
 
 def test_crash_at_start_scores_zero_with_its_traceback(graded):

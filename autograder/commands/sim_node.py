@@ -160,22 +160,15 @@ class NodeRun:
 
 
 def _refuse_unreadable(node_file: Path) -> None:
-    """A link, device or FIFO as the node file (or beside it) is refused, as grading does."""
-    from autograder.core.submission import SubmissionRefused, read_submission
+    """What grading refuses is refused here, before the world starts (exit 2): a link,
+    device or FIFO as the node file (or beside it), and a file that is not a node Python
+    runs (a syntax error with Python's own lines: :mod:`autograder.core.source`)."""
+    from autograder.core.submission import SubmissionNotFound, check
 
     try:
-        read_submission(node_file, node_file.name)
-    except SubmissionRefused as exc:
+        check(node_file, node_file.name)
+    except SubmissionNotFound as exc:
         raise UsageProblem(str(exc)) from None
-
-
-def _check_syntax(script: Path) -> None:
-    """A syntax error is said at once, as grading says it, instead of after a start-up."""
-    try:
-        compile(script.read_text(encoding="utf-8", errors="replace"), script.name, "exec")
-    except SyntaxError as exc:
-        raise NodeFailed(_("{file}, line {line}: {error}").format(
-            file=script.name, line=exc.lineno, error=exc.msg)) from None
 
 
 def node_exercise(script: Path, given: str | None) -> Exercise | None:
@@ -252,8 +245,7 @@ def add_node_options(run: click.Command) -> None:
             if exercise is not None or params:
                 raise click.UsageError(_("--exercise and --param go with --node FILE."))
             return original(**kwargs)
-        _refuse_unreadable(node_file)
-        _check_syntax(node_file)  # before the world: nothing to watch
+        _refuse_unreadable(node_file)  # before the world: nothing to watch
         found = node_exercise(node_file, exercise)
         if found is not None:
             click.echo(_("Running {file} as the node '{node}' of exercise {exercise}.").format(

@@ -114,9 +114,17 @@ def read_submission(source: Path, filename: str) -> dict[str, bytes]:
 
 def check(submission: Path, filename: str) -> Path:
     """The student's file in ``submission``, read once to refuse what the grader will not
-    take (:class:`SubmissionNotFound`, :class:`SubmissionRefused`) before any grading."""
+    take (:class:`SubmissionNotFound`, :class:`SubmissionRefused`) before any grading:
+    besides what :func:`read_untrusted` refuses, a file that is not a node Python runs
+    (:func:`autograder.core.source.check_source`: not ``.py``, empty, not UTF-8, a syntax
+    error, no node), named as the student gave it."""
+    from autograder.core.source import SourceRefused, check_source
+
     source = locate(submission, filename)
-    read_submission(source, filename)
+    try:
+        check_source(read_submission(source, filename), filename, str(source))
+    except SourceRefused as exc:
+        raise SubmissionRefused(str(exc)) from None
     return source
 
 

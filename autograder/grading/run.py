@@ -61,6 +61,9 @@ def grade(exercise: Exercise, submission: Path | None, *, hidden: bool = True,
     (``auto``: one per module as far as the cores go); a given ``domain`` means one child.
     """
     started = time.monotonic()
+    refusal = _refusal(exercise, submission)
+    if refusal is not None:  # nothing to run: no world, no domain, no child
+        return _refused(exercise, refusal, time.monotonic() - started)
     isolation = detect()
     if isolation.mode == "user":  # no mount namespace hides them: permissions must
         close_to_others(protected_paths(exercise.folder.parent.parent))
@@ -264,6 +267,33 @@ def _score(status: str, max_score: Fraction, fraction: float | None) -> Fraction
     if fraction:
         return Fraction(round(fraction * max_score * 100), 100)
     return Fraction(0)
+
+
+def _refusal(exercise: Exercise, submission: Path | None) -> str | None:
+    """Why the student's file cannot be graded at all (a link, no file, not a node Python
+    runs: :func:`autograder.core.submission.check`), or None."""
+    from autograder.core.submission import SubmissionNotFound, check
+
+    if submission is None:
+        return None
+    try:
+        check(Path(submission), exercise.file)
+    except SubmissionNotFound as exc:
+        return str(exc)
+    return None
+
+
+def _refused(exercise: Exercise, message: str, elapsed: float) -> RunResult:
+    """A file refused before any test ran (``grade-batch``): one failed test worth the
+    exercise's points, saying why once, so the gradebook shows a 0 out of the whole."""
+    test = TestResult(
+        name="submission_runs", label=_("Your file is a ROS node that Python runs"),
+        score=Fraction(0), max_score=Fraction(exercise.points or 1), status="failed",
+        message=message,
+        hint=_("Nothing was graded: fix this, then check again."))
+    return RunResult(kind="exercise", id=exercise.id, title=exercise.localized_title,
+                     tests=(test,), pass_mark=exercise.pass_fraction, lang=get_language(),
+                     execution_time=elapsed, data={"refused": True})
 
 
 def _forged(exercise: Exercise, elapsed: float) -> RunResult:

@@ -83,6 +83,12 @@ class Run:
     statuses: list[tuple[float, Any]]
     plans: list[tuple[float, Any]]
     frozen_at: float | None = None
+    # Where the half-pace phase ended (None: at ``end``; the hidden run's is a short one).
+    slow_until: float | None = None
+
+    @property
+    def slow_end(self) -> float:
+        return self.end if self.slow_until is None else min(self.slow_until, self.end)
 
     def command_times(self, a: float | None = None, b: float | None = None) -> list[float]:
         a = self.start if a is None else a
@@ -112,11 +118,13 @@ def _watch(probe, streams: Streams, seconds: float, wall_factor: float) -> float
 
 
 def observe(probe, world, streams: Streams, end_at: float = END_AT,
-            switch_at: float | None = SWITCH_AT, rtf: float | None = None) -> Run:
+            switch_at: float | None = SWITCH_AT, rtf: float | None = None,
+            slow_for: float | None = None) -> Run:
     """Watch the node to ``end_at`` after its start: at ``rtf`` (None: the world's pace)
-    until ``switch_at`` of sim time, then at OTHER_RTF (``switch_at`` None: not at all).
-    The world changes pace itself at those sim times (the grader's thread may wake late on
-    a loaded machine), so the phases are the same in every run."""
+    until ``switch_at`` of sim time, then at OTHER_RTF (``switch_at`` None: not at all)
+    to the end, or for ``slow_for`` sim seconds and then at ``rtf`` again.  The world
+    changes pace itself at those sim times (the grader's thread may wake late on a loaded
+    machine), so the phases are the same in every run."""
     commands = streams.commands
     if not probe.wait_for(lambda: len(commands) > 0, 5.0):
         return Run(None, None, probe.now, [], streams.statuses.items, streams.plans.items)
@@ -124,11 +132,15 @@ def observe(probe, world, streams: Streams, end_at: float = END_AT,
     if rtf is not None:
         world.set_real_time_factor(rtf)
     end = streams.started + end_at
+    watched = rtf or pace
+    slow_until = None
     if switch_at is not None:
         switch_at = max(switch_at, probe.now)
         world.schedule_real_time_factor(switch_at, OTHER_RTF)
+        if slow_for is not None:
+            slow_until = switch_at + slow_for
+            world.schedule_real_time_factor(slow_until, watched)
         world.schedule_real_time_factor(end, pace)
-    watched = rtf or pace
     slowest = watched if switch_at is None else min(watched, OTHER_RTF)
     try:
         start = max(streams.started, commands.times[0]) + SETTLE
@@ -147,8 +159,11 @@ def observe(probe, world, streams: Streams, end_at: float = END_AT,
             frozen = last
     else:
         end = frozen + FROZEN
+    if slow_until is not None:  # the first tick at or after it (see the world's log)
+        back = [t for t, to in world.pace_changes if t >= slow_until - 1e-9 and to == watched]
+        slow_until = back[0] if back else slow_until
     return Run(start, switch, end, commands.items, streams.statuses.items,
-               streams.plans.items, frozen)
+               streams.plans.items, frozen, slow_until)
 
 
 def _let_in_flight_arrive(probe, commands, end: float) -> None:
@@ -238,9 +253,41 @@ def too_fast(count: int, seconds: float, hz: float) -> bool:
 
 
 def wall_clock_hint() -> str:
-    return _("Time everything with the node's timers (self.create_timer) and clock "
-             "(self.get_clock()), never time.sleep or time.time: with use_sim_time they "
-             "follow /clock, whatever its pace.")
+    return _("Make every timer with self.create_timer(period, callback) and no clock= "
+             "argument, and read time with self.get_clock(): with use_sim_time they follow "
+             "/clock, whatever its pace. A Clock() made by hand (ClockType.STEADY_TIME or "
+             "SYSTEM_TIME), time.sleep and time.time keep the wall clock.")
+
+
+def wall_clock_evidence(run: Run) -> str | None:
+    """What shows that the node times cmd_vel by the wall clock, or None.
+
+    At half pace a 10 Hz timer on the wall clock fires twice per 0.1 s of sim time, and
+    more if the world lags; a timer on /clock cannot, as the world never runs faster
+    than its pace.  So this finding holds whatever the load, where the rates the node
+    showed at twice real time depend on how fast the world kept up.
+    """
+    if run.start is None or run.switch is None:
+        return None
+    seconds = run.slow_end - run.switch
+    count = len(run.command_times(run.switch, run.slow_end))
+    if seconds <= 0 or not too_fast(count, seconds, CONTROL_HZ):
+        return None
+    return _("With the world at half speed, cmd_vel came {count} times in {seconds:.2f} s of "
+             "simulation time ({rate:.1f} Hz): the node's timers keep the wall clock, not "
+             "/clock.").format(count=count, seconds=seconds, rate=count / seconds)
+
+
+def require_sim_clock(run: Run, what: str) -> None:
+    """Lose ``what`` for a node found timing by the wall clock: its rates in sim time
+    would depend on how fast the world ran on the machine, so they are not measured."""
+    evidence = wall_clock_evidence(run)
+    if evidence is not None:
+        raise StudentFailure(
+            _("{evidence} So {what} in simulation time would depend on how fast the world "
+              "ran on the grading machine: it is not measured, and this test is lost.")
+            .format(evidence=evidence, what=what),
+            wall_clock_hint())
 
 
 def gaps(times: list[float], start: float, end: float) -> list[tuple[float, float]]:

@@ -1,4 +1,5 @@
 """Hostile: sleeps forever at import; no node is ever created."""
+from rclpy.node import Node  # noqa: F401 - passes the grader's static node check; no node is made
 import time
 
 time.sleep(10**9)
