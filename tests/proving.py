@@ -340,6 +340,7 @@ def test_starter_is_below_the_pass_mark(graded: dict[str, RunResult]) -> None:
     assert result.grader_error is None, explain(**diagnosis(result))
     assert not result.passed
     assert result.score < result.max_score * result.pass_mark
+    assert result.core_missed, "the starter passes every core test"  # as validate has it
 
 
 def test_other_correct_designs_score_full_marks(graded: dict[str, RunResult],
@@ -363,6 +364,24 @@ def test_known_bad_variant_loses_exactly_the_tests_aimed_at_it(
             "passed, though expected lost": sorted(variant.loses - lost),
             "lost, though not expected": sorted(lost - variant.loses - variant.may_also_lose)},
         **diagnosis(result))
+
+
+def test_known_bad_variant_passes_only_with_every_core_test(
+        graded: dict[str, RunResult], proof: Proof, known_bad: str) -> None:
+    """A variant that loses a core test (exercise.yaml's ``core``) does not pass, whatever
+    its points, and its results name exactly the core tests it lost; one that loses none
+    passes or not by its points alone."""
+    result = graded[known_bad]
+    variant = proof.variants[known_bad]
+    core = set(find_exercise(proof.exercise).core)
+    assert core, f"{proof.exercise} names no core tests"
+    lost_core = failed_tests(result) & core
+    assert {t.name for t in result.core_missed} == lost_core, explain(**diagnosis(result))
+    assert variant.loses & core <= lost_core
+    assert result.passed == (result.fraction >= result.pass_mark and not lost_core), explain(
+        why=variant.why, core_lost=sorted(lost_core), **diagnosis(result))
+    if variant.loses & core:
+        assert not result.passed
 
 
 def test_known_bad_variant_is_told_what_was_observed(
@@ -390,6 +409,7 @@ STANDARD_CHECKS = (test_reference_scores_full_marks_every_time,
                    test_starter_is_below_the_pass_mark,
                    test_other_correct_designs_score_full_marks,
                    test_known_bad_variant_loses_exactly_the_tests_aimed_at_it,
+                   test_known_bad_variant_passes_only_with_every_core_test,
                    test_known_bad_variant_is_told_what_was_observed,
                    test_each_hint_is_given_once)
 

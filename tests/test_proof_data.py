@@ -219,3 +219,31 @@ def test_both_velocity_types_must_be_named_in_every_lost_test() -> None:
     stamped_only = "publishes geometry_msgs/msg/TwistStamped on /cmd_vel"
     assert without_both_types(result(both, stamped_only, "nothing on cmd_vel")) == {
         "test_1": stamped_only, "test_2": "nothing on cmd_vel"}
+
+
+@pytest.mark.parametrize("exercise", EXERCISES)
+def test_each_core_test_is_lost_by_a_known_bad_variant_that_then_fails(exercise: str) -> None:
+    """Every core test of an exercise has a one-flaw variant in its proof that loses it, so
+    the proof shows that breaking that requirement fails the grading (the check itself is
+    proving's test_known_bad_variant_passes_only_with_every_core_test)."""
+    core = set(find_exercise(exercise).core)
+    assert core and core <= exercise_tests(find_exercise(exercise))
+    lost = {test for v in load_variants(find_exercise(exercise)).values()
+            if v.kind == "mutant" for test in v.loses}
+    assert not core - lost, f"no mutant of {exercise} loses {sorted(core - lost)}"
+
+
+def test_the_core_check_fails_a_variant_that_passes_without_a_core_test() -> None:
+    """The proof's core check catches a grading that passed on points with a core test lost."""
+    from fractions import Fraction
+
+    from autograder.core.results import RunResult, TestResult
+
+    tests = (TestResult("test_refuses_out_of_range", "refuses", Fraction(0), Fraction(2),
+                        "failed"),  # core, but not marked so: the grader forgot it
+             TestResult("test_node_starts", "starts", Fraction(11), Fraction(11), "passed"))
+    graded = {"accepts_out_of_range": RunResult("exercise", "parameter_validation", "T",
+                                                tests)}
+    with pytest.raises(AssertionError):
+        proving.test_known_bad_variant_passes_only_with_every_core_test(
+            graded, Proof("parameter_validation"), "accepts_out_of_range")
