@@ -110,3 +110,94 @@ def test_a_domain_in_use_on_the_wire_is_skipped(lock_dir):
             with reserve_domain(free):
                 pass
     assert not busy_on_the_wire(free)
+
+
+# A student's program (a user of its own) locks every shared lock file and binds a socket
+# on every grading domain's first port; half the locks it hands to a child and exits, so
+# the kernel no longer names a live holder for them.
+HOARDER = """
+import fcntl, os, socket, sys, time
+folder = sys.argv[1]
+held, socks = [], []
+for domain in range({first}, {last} + 1):
+    path = f"{{folder}}/domain-{{domain}}.lock"
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_CREAT, 0o666)
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        held.append(fd)
+    except OSError:
+        pass
+    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    try:
+        s.bind(("127.0.0.1", {base} + {gain} * domain))
+        socks.append(s)
+    except OSError:
+        s.close()
+if os.fork() == 0:  # the child keeps every lock; the locker itself is gone
+    os.setsid()
+    print("HELD", len(held), flush=True)
+    sys.stdin.read()
+    os._exit(0)
+os._exit(0)
+"""
+
+
+def _hold_as(uid: int, code: str, *args: str) -> subprocess.Popen:
+    """``code`` run as ``uid``; it says its first line once it holds what it holds, and
+    lets go when its stdin closes."""
+    return subprocess.Popen(["setpriv", f"--reuid={uid}", f"--regid={uid}", "--clear-groups",
+                             sys.executable, "-I", "-c", code, *args],
+                            stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True, cwd="/")
+
+
+def _let_go(process: subprocess.Popen) -> None:
+    assert process.stdin is not None
+    process.stdin.close()
+    process.wait(timeout=30)
+
+
+@as_root
+def test_a_students_program_holding_every_lock_leaves_the_domains_free(lock_dir):
+    """Issue 29: a program of a student's own user that locks every shared lock file
+    (through a child, its locker gone) and binds every domain's port blocks nobody: root
+    and an ordinary user both still get a domain."""
+    from autograder.sandbox.domains import LAST_DOMAIN
+    from autograder.sandbox.sweep import STUDENT_UID_BASE
+
+    lock_dir.mkdir(mode=0o1777)
+    lock_dir.chmod(0o1777)
+    student = STUDENT_UID_BASE + 7
+    hoarder = _hold_as(student, HOARDER.format(first=FIRST_DOMAIN, last=LAST_DOMAIN,
+                                               base=PORT_BASE, gain=DOMAIN_GAIN), str(lock_dir))
+    try:
+        assert hoarder.stdout is not None
+        said = hoarder.stdout.readline().split()  # ends with the child: a deadline of its own
+        assert said and said[0] == "HELD" and int(said[1]) == LAST_DOMAIN - FIRST_DOMAIN + 1
+        with hold_domain() as mine:
+            assert FIRST_DOMAIN <= mine.domain <= LAST_DOMAIN
+        assert _as_nobody(lock_dir).startswith("domain "), "the ordinary user got none"
+    finally:
+        _let_go(hoarder)
+        subprocess.run(["pkill", "-KILL", "-u", str(student)], check=False)
+
+
+@as_root
+def test_a_lock_an_ordinary_users_run_holds_is_respected_by_root(lock_dir):
+    """Only students' users are passed over: a lock of another user's run keeps its
+    domain from root."""
+    lock_dir.mkdir(mode=0o1777)
+    lock_dir.chmod(0o1777)
+    with reserve_domain() as free:
+        pass
+    holder = _hold_as(NOBODY, "import fcntl, os, sys\n"
+                      "fd = os.open(sys.argv[1], os.O_RDONLY | os.O_CREAT, 0o666)\n"
+                      "fcntl.flock(fd, fcntl.LOCK_EX)\nprint('HELD', flush=True)\n"
+                      "sys.stdin.read()\n", str(lock_dir / f"domain-{free}.lock"))
+    try:
+        assert holder.stdout is not None and holder.stdout.readline().strip() == "HELD"
+        with pytest.raises(NoDomain), hold_domain(free):
+            pass
+    finally:
+        _let_go(holder)
+    with hold_domain(free) as lock:
+        assert lock.domain == free

@@ -178,7 +178,8 @@ def test_another_users_socket_on_the_domain_is_a_disturbance_not_the_students(gr
     sockets = [(12, GRADER), (12, OTHER)]
     watch = _wired(graph, sockets)
     assert watch.charge_split() == (
-        [], ["a program of another user (uid 200013) joined this grading's ROS domain 12"])
+        [], [("a program of another user (uid 200013) joined this grading's ROS domain 12",
+              200013)])
     sockets.remove((12, OTHER))
     assert watch.charge_split() == ([], [])  # gone: the next test is not disturbed
 
@@ -206,7 +207,8 @@ def test_in_basic_isolation_only_other_users_are_strangers(graph):
     grader's anywhere; another user's on the domain are a stranger's."""
     watch = _wired(graph, [(12, GRADER), (40, GRADER), (12, 1001)], student=GRADER)
     assert watch.charge_split() == (
-        [], ["a program of another user (uid 1001) joined this grading's ROS domain 12"])
+        [], [("a program of another user (uid 1001) joined this grading's ROS domain 12",
+              1001)])
 
 
 def test_ports_the_kernel_hands_out_belong_to_no_domain():

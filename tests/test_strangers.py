@@ -10,11 +10,13 @@ own grading."""
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import subprocess
 import sys
 import tempfile
 import textwrap
+import time
 from pathlib import Path
 
 import pytest
@@ -218,3 +220,69 @@ def test_the_loopback_profile_talks_across_users_and_binds_nothing_else():
     assert bound, output
     for address in bound:
         assert address == "127.0.0.1" or 224 <= int(address.split(".")[0]) <= 239, bound
+
+
+def test_a_program_that_hoards_every_domain_blocks_no_classmate(shout):
+    """A student's program locks every shared domain lock and binds every grading
+    domain's first port, and keeps a daemon holding them. A classmate's grading started
+    meanwhile still gets a domain; where the hoarder's socket sat on its domain it is
+    graded again once the hoarder is gone, and keeps its full marks. The hoarder's own
+    grading fails for joining domains not its own."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    marker = Path("/tmp")  # where the hoarder says it holds them
+    before = set(marker.glob("hoarding-*"))
+    with ThreadPoolExecutor(max_workers=1) as pool:
+        hoarding = pool.submit(grade, shout, CORPUS / "holds_every_domain")
+        deadline = time.monotonic() + shout.time_limit
+        while not set(marker.glob("hoarding-*")) - before and not hoarding.done():
+            assert time.monotonic() < deadline, "the hoarder never started"
+            time.sleep(0.05)
+        overlapping = not hoarding.done()
+        classmate = grade(shout, COURSE / "assignments" / "shout" / "solution")
+        hoarder = hoarding.result()
+    assert overlapping, "the hoarder's grading ended before the classmate's began"
+    held = re.findall(r"^HOARDING (\d+) LOCKS (\d+) PORTS AS UID (\d+)$", hoarder.log, re.M)
+    assert sum(int(locks) for locks, _ports, _uid in held) > 0, hoarder.log[-2000:]
+    assert classmate.grader_error is None, classmate.grader_details
+    assert classmate.score == classmate.max_score
+    for strangers in classmate.data.get("disturbed", []):
+        assert set(strangers) <= {int(uid) for _locks, _ports, uid in held}
+    assert hoarder.grader_error is None and hoarder.score < hoarder.max_score
+    assert "which is not its own" in "\n".join(t.message for t in hoarder.tests)
+
+
+def test_a_disturbed_grading_is_graded_again_once_the_stranger_is_gone(shout):
+    """A socket of another grading's student sits on this grading's domain for a few
+    seconds: the tests it overlapped prove nothing, so the whole grading is done again
+    once that user has nothing left on the machine, and its full marks stand."""
+    from autograder.sandbox.domains import DOMAIN_GAIN, PORT_BASE
+    from autograder.sandbox.sweep import STUDENT_UID_BASE
+
+    stranger = STUDENT_UID_BASE + 230  # a domain no grading here uses
+    with hold_domain() as free:
+        domain = free.domain
+    code = (f"import socket, sys\ns = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)\n"
+            f"s.bind(('127.0.0.1', {PORT_BASE + DOMAIN_GAIN * domain}))\n"
+            f"print('BOUND', flush=True)\nsys.stdin.read()\n")
+    sitter = subprocess.Popen(["setpriv", f"--reuid={stranger}", f"--regid={stranger}",
+                               "--clear-groups", sys.executable, "-I", "-c", code],
+                              stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
+                              cwd="/")
+    assert sitter.stdout is not None and sitter.stdin is not None
+    _wait_for(sitter, "BOUND")
+
+    def leave_once_seen(test) -> None:  # the first test's end: it overlapped the sitter
+        if not sitter.stdin.closed:
+            sitter.stdin.close()
+
+    try:
+        result = grade(shout, COURSE / "assignments" / "shout" / "solution", domain=domain,
+                       progress=leave_once_seen)
+    finally:
+        if not sitter.stdin.closed:
+            sitter.stdin.close()
+        sitter.wait(timeout=30)
+    assert result.data.get("disturbed") == [[stranger]]
+    assert result.grader_error is None, result.grader_details
+    assert result.score == result.max_score

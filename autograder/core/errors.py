@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from sim.content import ContentError
 
-__all__ = ["ContentError", "GraderError", "StudentFailure"]
+__all__ = ["ContentError", "Disturbed", "GraderError", "StudentFailure"]
 
 
 class StudentFailure(AssertionError):
@@ -22,3 +22,13 @@ class StudentFailure(AssertionError):
 
 class GraderError(Exception):
     """The autograder itself failed (our bug, the simulator, a missing dependency)."""
+
+
+class Disturbed(GraderError):
+    """Programs of other users (``uids``) were on the grading's ROS domain: what the test
+    saw proves nothing, about the student or anyone. The grading is done again once they
+    are gone."""
+
+    def __init__(self, message: str, uids: tuple[int, ...]) -> None:
+        super().__init__(message)
+        self.uids = uids

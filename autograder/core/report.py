@@ -37,6 +37,7 @@ class RawTest:
     details: str = ""
     fraction: float | None = None
     charts: list[dict[str, Any]] = dataclasses.field(default_factory=list)
+    strangers: list[int] = dataclasses.field(default_factory=list)  # who disturbed it
 
 
 @dataclasses.dataclass

@@ -30,7 +30,7 @@ from autograder.grading.children import Progress, Watchers
 from autograder.grading.footprint import Footprint
 from autograder.grading.modules import ModuleJobs, children_for, find_modules, merge, share_out
 from autograder.i18n import _, get_language
-from autograder.sandbox.domains import DomainLock, NoDomain, hold_domain
+from autograder.sandbox.domains import DomainLock, NoDomain, hold_domain, udp_sockets
 from autograder.sandbox.isolation import (
     Isolation,
     close_to_others,
@@ -39,8 +39,12 @@ from autograder.sandbox.isolation import (
     run_prefix,
     student_uid,
 )
+from autograder.sandbox.sweep import user_processes
 
 GRADER_FAULT = "the autograder failed, tell your instructor"
+# A grading that other users' programs disturbed is done again once they are gone, at
+# most this many times; then its grader fault stands.
+REGRADES = 2
 
 
 
@@ -60,6 +64,38 @@ def grade(exercise: Exercise, submission: Path | None, *, hidden: bool = True,
     ``module_jobs`` children run the test modules at once, each on a domain of its own
     (``auto``: one per module as far as the cores go); a given ``domain`` means one child.
     """
+    disturbed: list[list[int]] = []
+    while True:
+        result = _grade_once(exercise, submission, hidden=hidden, domain=domain,
+                             real_time_factor=real_time_factor, progress=progress,
+                             running=running, record=record, module_jobs=module_jobs)
+        strangers = result.data.get("strangers") or []
+        if result.grader_error is None or not strangers or len(disturbed) >= REGRADES:
+            break
+        disturbed.append(strangers)  # what it saw proves nothing: again, once they left
+        _wait_until_gone(strangers, exercise.time_limit)
+    if disturbed:
+        result = dataclasses.replace(result, data={**result.data, "disturbed": disturbed})
+    return result
+
+
+def _wait_until_gone(uids: Sequence[int], seconds: float) -> None:
+    """Wait (up to ``seconds``) until no process and no socket of ``uids`` is left on the
+    machine: another grading's student ends with its grading, within its time limit."""
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        if not any(user_processes(uid) for uid in uids) and \
+                not any(uid in uids for _port, uid in udp_sockets()):
+            return
+        time.sleep(0.2)
+
+
+def _grade_once(exercise: Exercise, submission: Path | None, *, hidden: bool,
+                domain: int | None, real_time_factor: float | None,
+                progress: Progress | None,
+                running: Callable[[RawTest | None], None] | None,
+                record: Path | None, module_jobs: ModuleJobs) -> RunResult:
+    """One grading of ``submission`` (see :func:`grade`)."""
     started = time.monotonic()
     refusal = _refusal(exercise, submission)
     if refusal is not None:  # nothing to run: no world, no domain, no child
@@ -361,7 +397,8 @@ def _result(exercise: Exercise, raw_report: RawReport, ended: Sequence[children.
               "timed_out": any(e.timed_out for e in ended),
               "startup_seconds": data.get("startup_seconds", []),
               "pacing": data.get("pacing", {}), "bags": data.get("bags", {}),
-              "warnings": data.get("warnings", [])})
+              "warnings": data.get("warnings", []),
+              "strangers": sorted({uid for raw in raw_report.tests for uid in raw.strangers})})
 
 
 def _not_run(exercise: Exercise, counted: dict[str, Any] | None,

@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING, Any
 
 import pytest
 
-from autograder.core.errors import GraderError, StudentFailure
+from autograder.core.errors import Disturbed, StudentFailure
 from autograder.i18n import _
 from autograder.plugin.probe import GRADER_NODES
 from autograder.plugin.stash import settings_key
@@ -184,8 +184,9 @@ class GraphWatch:
         start), in words, in the order first seen; later charges start from now."""
         return self.charge_split()[0]
 
-    def charge_split(self) -> tuple[list[str], list[str]]:
-        """:meth:`charge`, and besides what strangers did meanwhile (disturbances)."""
+    def charge_split(self) -> tuple[list[str], list[tuple[str, int]]]:
+        """:meth:`charge`, and besides what strangers did meanwhile (disturbances: in
+        words, with the stranger's user)."""
         self.look()
         with self._lock:
             since, self._charged = self._charged, self._clock()
@@ -193,7 +194,7 @@ class GraphWatch:
                    for f, spans in self._spans.items() if any(b >= since for _a, b in spans)]
         due.sort()
         return ([_describe(f) for _first, f in due if f[0] != "stranger"],
-                [_describe(f) for _first, f in due if f[0] == "stranger"])
+                [(_describe(f), int(f[1])) for _first, f in due if f[0] == "stranger"])
 
 
 # On a test module: the watch started with its probe (plugin/world.py).
@@ -227,9 +228,10 @@ def _graph_guard(request: pytest.FixtureRequest) -> Iterator[None]:
         if own:
             watch.stop()
     if strangers:  # whatever the student did meanwhile: this test proves nothing
-        raise GraderError(_(
+        raise Disturbed(_(
             "Disturbed: {what}. This grading cannot be trusted; grade again.").format(
-            what="; ".join(strangers)))
+            what="; ".join(words for words, _uid in strangers)),
+            tuple(sorted({uid for _words, uid in strangers})))
     if seen:
         raise StudentFailure(
             _("Tampering with the simulated world: {what}. Tests run while it happens are "

@@ -14,7 +14,7 @@ from typing import Any
 import pytest
 
 from autograder.core import report
-from autograder.core.errors import GraderError, StudentFailure
+from autograder.core.errors import Disturbed, GraderError, StudentFailure
 from autograder.core.output import (
     DETAILS_BYTES,
     LOG_TAIL_BYTES,
@@ -224,7 +224,7 @@ def _skip_reason(report: pytest.TestReport) -> str:
     return str(longrepr)
 
 
-def _classify(excinfo: pytest.ExceptionInfo[BaseException] | None) -> dict[str, str]:
+def _classify(excinfo: pytest.ExceptionInfo[BaseException] | None) -> dict[str, Any]:
     """A failing test's status: the student's failure, or our error."""
     if excinfo is None:
         return {"status": "failed", "message": "", "hint": "", "details": ""}
@@ -238,4 +238,5 @@ def _classify(excinfo: pytest.ExceptionInfo[BaseException] | None) -> dict[str, 
         return {"status": "failed", "message": text.split("\nassert")[0].strip() or
                 _("A check failed."), "hint": "", "details": details}
     kind = "grader error" if isinstance(error, GraderError) else type(error).__name__
-    return {"status": "error", "message": f"{kind}: {error}", "hint": "", "details": details}
+    return {"status": "error", "message": f"{kind}: {error}", "hint": "", "details": details,
+            **({"strangers": list(error.uids)} if isinstance(error, Disturbed) else {})}

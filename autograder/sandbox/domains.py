@@ -13,6 +13,12 @@ file another user created, whatever their umask, still works).  Where the shared
 cannot be used (made by an older version, or a read-only ``/tmp``), each user falls back
 to a folder of their own; other users' runs are then avoided by looking at the wire: a
 domain whose Fast DDS ports have a socket bound on this machine is taken.
+
+A student's program that runs as a user of its own (strict isolation, isolation by user)
+can open the shared lock files too, and bind sockets on any domain's ports. Neither may
+leave the machine without a domain, so root's runs coordinate through a folder only root
+can enter, and every run passes over a shared lock or a socket whose holder is a student's
+user: only graders and people's own nodes count as someone on a domain.
 """
 
 from __future__ import annotations
@@ -28,6 +34,7 @@ from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 from autograder.core.errors import GraderError
+from autograder.sandbox.sweep import is_student_uid
 
 # Domains 0-9 are left to people running nodes by hand; with Linux's default ephemeral
 # port range, ids up to 101 are safe for Fast DDS.
@@ -69,12 +76,20 @@ def _usable_shared(folder: Path) -> bool:
 
 
 def lock_dirs() -> tuple[Path, Path | None]:
-    """Where runs lock their domains: the shared folder, or where this user cannot use it,
-    a folder of this user's own (and the shared one's existing locks, as far as readable)."""
+    """Where runs lock their domains: the shared folder, or where this user cannot use it
+    (and always for root, whose students could lock the shared one), a folder of this
+    user's own; with the shared one's existing locks, as far as they can be opened."""
     shared = shared_lock_dir()
-    if _usable_shared(shared):
-        return shared, None
     uid = os.geteuid()
+    usable = _usable_shared(shared)
+    if usable and uid != 0:
+        return shared, None
+    return own_lock_dir(), (shared if usable or shared.is_dir() else None)
+
+
+def own_lock_dir() -> Path:
+    """A lock folder only this user may enter."""
+    shared, uid = shared_lock_dir(), os.geteuid()
     for own in (shared.with_name(f"{shared.name}-{uid}"),
                 Path(tempfile.gettempdir()) / f"autograder-domains-{uid}",
                 Path.home() / ".cache" / "autograder-domains"):
@@ -83,7 +98,7 @@ def lock_dirs() -> tuple[Path, Path | None]:
         except OSError:
             continue
         if own.stat().st_uid == uid and os.access(own, os.W_OK):
-            return own, (shared if shared.is_dir() else None)
+            return own
     raise NoDomain(f"no folder for domain locks: {shared} cannot be used by this user "
                    f"(set AUTOGRADER_LOCK_DIR to a folder every grading user may write)")
 
@@ -131,9 +146,46 @@ def udp_sockets(tables: Iterable[str] = ("/proc/net/udp", "/proc/net/udp6"),
 def busy_on_the_wire(domain: int, tables: Iterable[str] = ("/proc/net/udp",
                                                             "/proc/net/udp6")) -> bool:
     """True if a UDP socket on this machine (this network namespace) is bound to one of
-    the domain's Fast DDS ports: someone is on that domain, locks or not."""
+    the domain's Fast DDS ports by anyone but a student's user: someone is on that
+    domain, locks or not. (A student's own grading holds its domain by its grader's lock;
+    its sockets elsewhere are no one's reservation.)"""
     low = PORT_BASE + DOMAIN_GAIN * domain
-    return any(low <= port < low + DOMAIN_GAIN for port, _uid in udp_sockets(tables))
+    return any(low <= port < low + DOMAIN_GAIN and not is_student_uid(uid)
+               for port, uid in udp_sockets(tables))
+
+
+def lock_holders(path: Path, locks: str = "/proc/locks",
+                 proc: str = "/proc") -> list[int | None]:
+    """The users of the processes holding a ``flock`` on ``path``, as the kernel lists
+    them: None where the process that took it has ended (a child holds it) or cannot be
+    read."""
+    try:
+        info = path.stat()
+        table = Path(locks).read_text().splitlines()
+    except OSError:
+        return []
+    device = f"{os.major(info.st_dev):02x}:{os.minor(info.st_dev):02x}:{info.st_ino}"
+    holders: list[int | None] = []
+    for line in table:
+        fields = line.split()
+        if len(fields) < 6 or fields[1] != "FLOCK" or fields[5] != device:
+            continue
+        try:
+            status = Path(proc, fields[4], "status").read_text()
+            holders.append(int(status.split("\nUid:", 1)[1].split()[0]))
+        except (OSError, IndexError, ValueError):
+            holders.append(None)
+    return holders
+
+
+def held_by_students_only(path: Path, domain: int) -> bool:
+    """True if the only holders of ``path``'s lock are students' programs (a lock another
+    user's run holds is never passed over; where its holder is unknown, the domain's
+    ports tell)."""
+    holders = lock_holders(path)
+    if any(uid is not None and not is_student_uid(uid) for uid in holders):
+        return False
+    return None not in holders or not busy_on_the_wire(domain)
 
 
 @functools.cache
@@ -188,6 +240,12 @@ def _take(domain: int, own: Path, shared: Path | None) -> DomainLock | None:
     held = [_lock(own, domain)]
     if shared is not None:
         held.append(_lock(shared, domain))
+    # A lock only students' programs hold is no one's reservation. Where it is the one
+    # this user's runs coordinate through, a lock in a folder of the user's own stands in.
+    for i, folder in enumerate((own, shared)):
+        if folder is not None and held[i] == TAKEN \
+                and held_by_students_only(folder / f"domain-{domain}.lock", domain):
+            held[i] = _lock(own_lock_dir(), domain) if i == 0 else UNAVAILABLE
     fds = tuple(fd for fd in held if fd >= 0)
     if held[0] < 0 or TAKEN in held or busy_on_the_wire(domain):
         for fd in fds:
