@@ -8,9 +8,11 @@ from __future__ import annotations
 
 import json
 import shutil
+import signal
 import sys
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import click
 
@@ -21,16 +23,22 @@ from autograder.i18n import LANGUAGES, _, get_language, ngettext, set_language
 
 
 def _sim_cli() -> click.Command:
+    from autograder.commands.ending import until_stopped
     from autograder.commands.sim_node import add_node_options
     from sim.cli import sim_cli
 
     add_node_options(sim_cli.commands["run"])  # sim knows nothing of students' nodes
+    # Run until stopped: a closed pipe stops them as Ctrl-C does (commands.ending).
+    until_stopped(sim_cli.commands["run"], lambda options: options["duration"] is None)
+    until_stopped(sim_cli.commands["drive"], lambda options: options["seconds"] is None)
     return sim_cli
 
 
 def _quiz_cli() -> click.Command:
+    from autograder.commands.ending import until_stopped
     from autograder.quiz.cli import quiz_cli
 
+    until_stopped(quiz_cli.commands["serve"], lambda options: True)
     return quiz_cli
 
 
@@ -55,6 +63,28 @@ class LazyGroup(click.Group):
         if cmd_name in self.lazy and cmd_name not in self.commands:
             self.add_command(self.lazy[cmd_name](), cmd_name)
         return super().get_command(ctx, cmd_name)
+
+    def main(self, *args: Any, **kwargs: Any) -> Any:
+        """Every command ends cleanly however it is stopped: a signal, a dead parent, a
+        closed pipe (:mod:`autograder.commands.ending`)."""
+        from autograder.commands import ending
+
+        with ending.handled() as state:
+            try:
+                return super().main(*args, **kwargs)
+            except SystemExit as exc:
+                if state.signum in ending.ENDING_SIGNALS:
+                    click.echo(_("Stopped by {signal}.").format(
+                        signal=signal.Signals(state.signum).name), err=True)
+                raise SystemExit(state.exit_status(exc.code)) from None
+
+    def invoke(self, ctx: click.Context) -> Any:
+        from autograder.commands.ending import Stopped
+
+        try:
+            return super().invoke(ctx)
+        except Stopped:  # not Ctrl-C: the status says which signal, not "Aborted!"
+            ctx.exit(1)
 
 
 @click.group(cls=LazyGroup)
@@ -169,6 +199,7 @@ def refuse_unofficial(option: str) -> None:
 def _run(exercise: str, submission: Path, hidden: bool, outputs: dict[str, Path | None],
          rtf: float | None, domain: int | None, record: Path | None = None,
          module_jobs: int | str = "auto", require_official: bool = False) -> None:
+    from autograder.commands.ending import Stopped
     from autograder.core.report import RawTest
     from autograder.core.submission import SubmissionNotFound, check
     from autograder.grading.run import grade, result_of
@@ -200,11 +231,19 @@ def _run(exercise: str, submission: Path, hidden: bool, outputs: dict[str, Path 
         result = grade(found, submission, hidden=hidden, domain=domain, real_time_factor=rtf,
                        progress=lambda raw: live.done(result_of(raw)), running=running,
                        record=record, module_jobs=module_jobs)
+    except Stopped as exc:  # what the grading started is stopped and removed by now
+        live.close()
+        click.echo(for_terminal(_("The grading was stopped ({signal}) before it finished: "
+                                  "no score, and no file written.").format(signal=exc.name)),
+                   err=True)
+        raise
     finally:
         live.close()
+    # The files first: whatever happens to stdout (a pipe closed early), they are written.
+    written = write_outputs(result, outputs, found.folder)
     click.echo(to_terminal(result, color=color, shown=live.shown, with_heading=False))
     _say_recorded(result, record)
-    write_outputs(result, outputs, found.folder)
+    _say_written(written)
     if result.grader_error:
         raise GraderFault(result.grader_error)
 
@@ -224,10 +263,26 @@ def _say_recorded(result, record: Path | None) -> None:  # noqa: ANN001 - a RunR
         click.echo(for_terminal(_("Warning: {message}").format(message=warning)), err=True)
 
 
-def write_outputs(result, outputs: dict[str, Path | None], folder: Path) -> None:  # noqa: ANN001
+def _say_written(written: list[tuple[str, Path]]) -> None:
+    """Where each requested file went (on stderr, which a pipe on stdout leaves alone)."""
+    from autograder.render.terminal import for_terminal
+
+    for name, path in written:
+        if name == "html":
+            line = _("Wrote {path} (--html): open it in a browser.").format(path=path)
+        elif name == "log":
+            line = _("Wrote {path}: the programs' whole output.").format(path=path)
+        else:
+            line = _("Wrote {path} (--{option}).").format(path=path, option=name)
+        click.echo(for_terminal(line), err=True)
+
+
+def write_outputs(result, outputs: dict[str, Path | None],  # noqa: ANN001
+                  folder: Path) -> list[tuple[str, Path]]:
     """Write each requested output format of ``result`` (``--results``, ``--html``, ...:
     see :mod:`autograder.render`); with ``--results FILE``, the programs' whole output goes
-    to FILE with suffix ``.log`` (``log`` names another file for it)."""
+    to FILE with suffix ``.log`` (``log`` names another file for it). Each (format, path)
+    written, in order."""
     from autograder.core.files import write_atomically
     from autograder.core.output import log_beside
     from autograder.render import formats
@@ -235,12 +290,15 @@ def write_outputs(result, outputs: dict[str, Path | None], folder: Path) -> None
     outputs = dict(outputs)
     if outputs.get("results") is not None and result.kind == "exercise":
         outputs.setdefault("log", log_beside(outputs["results"]))
+    written = []
     for name, path in outputs.items():
         if path is None:
             continue
         path.parent.mkdir(parents=True, exist_ok=True)
         text = result.log if name == "log" else formats()[name].render(result, folder)
         write_atomically(path, text)
+        written.append((name, path))
+    return written
 
 
 def _formats(func):  # noqa: ANN001, ANN202

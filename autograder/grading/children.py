@@ -217,6 +217,24 @@ def _tell(children: Sequence[Child], reported: set[str], watchers: Watchers) -> 
     return running
 
 
+def abandon(running: Sequence[Child], grace: float = 10.0) -> None:
+    """The grading was stopped before its children ended (a signal, Ctrl-C), and their
+    lifelines are closed: each ends what it started and then itself. Wait for that (at
+    most ``grace`` seconds in all), then kill what is left and reap every program their
+    reports name, so that nothing of the student's outlives the grader and its folder
+    can go."""
+    deadline = time.monotonic() + grace
+    for child in running:
+        with contextlib.suppress(subprocess.TimeoutExpired):
+            child.process.wait(max(0.0, deadline - time.monotonic()))
+        with contextlib.suppress(ProcessLookupError, PermissionError):
+            os.killpg(child.process.pid, signal.SIGKILL)
+        with contextlib.suppress(subprocess.TimeoutExpired):
+            child.process.wait(5.0)
+        for process in report.read(child.report_path, child.key).processes:
+            reap_recorded(process)
+
+
 def end(child: Child) -> Ended:
     """The child's report, read (with its programs' logs) before anything is removed, and
     everything it started reaped (its process group, the students' cgroups)."""

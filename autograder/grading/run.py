@@ -225,16 +225,21 @@ def _run(exercise: Exercise, submission: Path | None, plan: _Plan,
         record=str(record) if record is not None else None,
         submission_name=_shown_name(exercise, submission))
     with tempfile.TemporaryDirectory(prefix="autograder-") as tmp:
-        with contextlib.ExitStack() as lifelines:
-            running = []
-            for index, (group, lock) in enumerate(zip(targets, locks, strict=False)):
-                count_only = tuple(str(f) for f in plan.count_only if f in group)
-                running.append(lifelines.enter_context(children.started(
-                    run_prefix(isolation), dataclasses.replace(settings, count_only=count_only),
-                    [str(t) for t in group], Path(tmp) / f"child-{index}", exercise.folder,
-                    lock, zygote=len(targets) == 1)))
-            footprint = Footprint([child.process.pid for child in running])
-            children.wait(running, exercise.time_limit, watchers, footprint)
+        running: list[children.Child] = []
+        try:
+            with contextlib.ExitStack() as lifelines:
+                for index, (group, lock) in enumerate(zip(targets, locks, strict=False)):
+                    count_only = tuple(str(f) for f in plan.count_only if f in group)
+                    running.append(lifelines.enter_context(children.started(
+                        run_prefix(isolation),
+                        dataclasses.replace(settings, count_only=count_only),
+                        [str(t) for t in group], Path(tmp) / f"child-{index}",
+                        exercise.folder, lock, zygote=len(targets) == 1)))
+                footprint = Footprint([child.process.pid for child in running])
+                children.wait(running, exercise.time_limit, watchers, footprint)
+        except BaseException:  # stopped (a signal, Ctrl-C): the children go before tmp
+            children.abandon(running)
+            raise
         ended = [children.end(child) for child in running]
     elapsed = time.monotonic() - started
     raw = merge(([e.raw for e in ended]), plan.order(exercise.folder))
