@@ -118,6 +118,23 @@ def _lang_option(func):  # noqa: ANN001, ANN202
                         help="Language of the feedback (en, ur).")(func)
 
 
+VERBOSE = "autograder.verbose"
+"""``ctx.meta`` key: ``--verbose`` was given (see :func:`_verbose_option`)."""
+
+
+def _verbose_option(func):  # noqa: ANN001, ANN202
+    """``--verbose``: the instructor's technical lines (how the program was contained and
+    bounded) instead of the student's sentence."""
+
+    def remember(ctx: click.Context, param: click.Parameter, value: bool) -> None:
+        ctx.meta[VERBOSE] = value
+
+    return click.option("--verbose", "-v", is_flag=True, default=False, expose_value=False,
+                        callback=remember,
+                        help="Say how the program was contained in technical terms "
+                             "(for instructors).")(func)
+
+
 @main.command("list")
 @click.option("--json", "as_json", is_flag=True, help="Print JSON for tools.")
 def list_command(as_json: bool) -> None:
@@ -241,7 +258,8 @@ def _run(exercise: str, submission: Path, hidden: bool, outputs: dict[str, Path 
         live.close()
     # The files first: whatever happens to stdout (a pipe closed early), they are written.
     written = write_outputs(result, outputs, found.folder)
-    click.echo(to_terminal(result, color=color, shown=live.shown, with_heading=False))
+    click.echo(to_terminal(result, color=color, shown=live.shown, with_heading=False,
+                           verbose=click.get_current_context().meta.get(VERBOSE, False)))
     _say_recorded(result, record)
     _say_written(written)
     if result.grader_error:
@@ -362,6 +380,7 @@ _record = click.option("--record", type=click.Path(path_type=Path, file_okay=Fal
 @_domain
 @_module_jobs
 @_record
+@_verbose_option
 @_lang_option
 def check(exercise: str, submission: Path, rtf: float | None, domain: int | None,
           module_jobs: int | str, record: Path | None, **outputs: Path | None) -> None:
@@ -381,6 +400,7 @@ def check(exercise: str, submission: Path, rtf: float | None, domain: int | None
               help="Refuse to grade (a grader fault, exit 3) where the grade could not be "
                    "official: the student's program would run as the grader's user. The "
                    "Gradescope bundle grades with it.")
+@_verbose_option
 @_lang_option
 def grade_command(exercise: str, submission: Path, rtf: float | None, domain: int | None,
                   module_jobs: int | str, record: Path | None, require_official: bool,

@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
 import click
+from click.core import ParameterSource
 
 from sim.content import ContentError
 from sim.i18n import _
@@ -231,6 +232,11 @@ def drive_command(topic: str, linear: float, angular: float, seconds: float | No
 
     if keys and not sys.stdin.isatty():
         raise NoTerminal(_("--keys needs a terminal: standard input is not one."))
+    if click.get_current_context().get_parameter_source("topic") is ParameterSource.DEFAULT:
+        click.echo(_("Warning: without --topic this drives {topic}, the robot's own "
+                     "topic, past any node of yours in between; to drive through your node, "
+                     "give its input, e.g. `--topic /agent/cmd_vel`.").format(topic=topic),
+                   err=True)
     drive(topic, Command(linear, angular), seconds=seconds, rate=rate, stamped=stamped,
           keys=keys, domain=_domain(domain))
 

@@ -596,7 +596,7 @@ def test_export_command_writes_both_formats(tmp_path: Path) -> None:
 def test_export_command_bad_input_exits_2(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     runner = CliRunner()
     result = runner.invoke(quiz_cli, ["export", "nope", "--format", "qti"])
-    assert result.exit_code == 2 and "no quiz 'nope'" in result.output
+    assert result.exit_code == 2 and "No quiz named nope" in result.output
     result = runner.invoke(quiz_cli, ["export", "rclpy-part2", "--format", "pdf"])
     assert result.exit_code == 2
     blocker = tmp_path / "file"

@@ -110,4 +110,4 @@ def test_malformed_quiz_in_cli_is_one_line_and_changes_nothing(course: Path) -> 
 
 def test_unknown_quiz_id_is_an_error(course: Path) -> None:
     result = CliRunner().invoke(quiz_cli, ["key", "no-such-quiz"])
-    assert result.exit_code == 2 and "no quiz 'no-such-quiz'" in result.output
+    assert result.exit_code == 2 and "No quiz named no-such-quiz" in result.output

@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Literal
 
 from autograder.core.course import course_root
-from autograder.core.errors import ContentError
+from autograder.core.names import unknown_exercise
 from autograder.i18n import _, content_text
 from sim.content import build, load_document
 from sim.pacing import DEFAULT_CLOCK_HZ, DEFAULT_CPU_BUDGET
@@ -161,7 +161,5 @@ def find_exercise(name: str) -> Exercise:
         return load_exercise(candidate)
     folder = assignments_dir() / name
     if not (folder / "exercise.yaml").exists():
-        known = ", ".join(e.id for e in list_exercises())
-        raise ContentError(folder / "exercise.yaml", _(
-            "no exercise {name!r} (known: {known})").format(name=name, known=known))
+        raise unknown_exercise(name, [e.id for e in list_exercises()], folder)
     return load_exercise(folder)

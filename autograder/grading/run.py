@@ -395,7 +395,8 @@ def _result(exercise: Exercise, raw_report: RawReport, ended: Sequence[children.
     return RunResult(
         kind="exercise", id=exercise.id, title=exercise.localized_title, tests=tuple(tests),
         pass_mark=exercise.pass_fraction, lang=get_language(), grader_error=grader_error,
-        grader_details=details, log_tail="\n".join(logs.values())[-4000:],
+        grader_details=details,
+        log_tail="\n".join(v for v in logs.values() if v.strip())[-4000:],
         log=raw_report.output_log, not_run=not_run,
         execution_time=elapsed,
         data={"recordings": data.get("recordings", {}),
@@ -403,7 +404,9 @@ def _result(exercise: Exercise, raw_report: RawReport, ended: Sequence[children.
               "startup_seconds": data.get("startup_seconds", []),
               "pacing": data.get("pacing", {}), "bags": data.get("bags", {}),
               "warnings": data.get("warnings", []),
-              "strangers": sorted({uid for raw in raw_report.tests for uid in raw.strangers})})
+              "strangers": sorted({uid for raw in raw_report.tests for uid in raw.strangers}),
+              # The student's programs ran and printed nothing at all: the report says so.
+              "silent": bool(logs) and not any(v.strip() for v in logs.values())})
 
 
 def _not_run(exercise: Exercise, counted: dict[str, Any] | None,

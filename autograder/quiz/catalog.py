@@ -6,8 +6,8 @@ import dataclasses
 from pathlib import Path
 
 from autograder.core.course import course_root
-from autograder.core.errors import ContentError
-from autograder.i18n import _, content_text
+from autograder.core.names import unknown_quiz
+from autograder.i18n import content_text
 from autograder.quiz.model import QuizFile, context, load_quiz
 
 
@@ -45,9 +45,8 @@ def find_quiz(name: str, root: Path | None = None) -> QuizFile:
         qf = load_quiz(p)
         if qf.quiz.id == name:
             return qf
-    known = ", ".join(load_quiz(p).quiz.id for p in quiz_paths(root)) or "-"
-    raise ContentError(quizzes_dir(root), _("no quiz {id!r} (quizzes: {known})").format(
-        id=name, known=known))
+    raise unknown_quiz(name, [load_quiz(p).quiz.id for p in quiz_paths(root)],
+                       quizzes_dir(root))
 
 
 def list_quizzes(root: Path | None = None) -> list[QuizEntry]:

@@ -183,11 +183,23 @@ def isolation_line(isolation: dict) -> str:
           "tests and change these results.")))
 
 
+def containment_sentence(isolation: dict) -> str:
+    """For students: in one sentence, whether their program was contained and why that
+    matters (the grade stands for what their node did, and only that). The technical
+    line (:func:`isolation_line`) is for instructors: ``--verbose`` and the JSON."""
+    if isolation.get("mode") in ("strict", "user"):
+        return _("Your program ran contained, as a user of its own, so this grade stands for "
+                 "what your node did and nothing else.")
+    return _("Your program was not contained (it ran as the grader's own user), so it could "
+             "have changed this result: this grade is not official.")
+
+
 def to_terminal(result: RunResult, color: bool = False, shown: Collection[str] = (),
-                with_heading: bool = True) -> str:
+                with_heading: bool = True, verbose: bool = False) -> str:
     """The whole summary: a line per test (but those in ``shown``, already printed as
     they ran: see :mod:`autograder.render.live`), each failure once with its message and
-    hint, then the score and what it proves."""
+    hint, then the score and what it proves; how the program was contained in a sentence
+    (``verbose``: the technical line)."""
     lines = [heading(result.id, result.title, color), ""] if with_heading else []
     lines += [test_line(t, color) for t in result.tests if line_key(t) not in shown]
     for block in failure_blocks(result.tests, color):
@@ -195,7 +207,7 @@ def to_terminal(result: RunResult, color: bool = False, shown: Collection[str] =
     lines += ["", *score_lines(result, color)]
     isolation = result.data.get("isolation", {})
     if isolation:
-        lines.append(isolation_line(isolation))
+        lines.append(isolation_line(isolation) if verbose else containment_sentence(isolation))
     if result.grader_error:
         lines.append(_style(_("The autograder failed, tell your instructor."), "yellow", color,
                             bold=True))
