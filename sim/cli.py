@@ -152,11 +152,11 @@ def run_world(spec, *, rtf: float, duration: float | None, domain: int,  # noqa:
     bridge = SimBridge(World(spec, seed=seed), ctx, real_time_factor=rtf, max_clock_hz=clock_hz,
                        **(companion.bridge_options() if companion is not None else {}))
     recorder = _recorder(bag, bridge, spec.name) if bag else None
-    click.echo(_("World {name} on ROS domain {domain}, RTF {rtf}. Ctrl-C stops.").format(
-        name=spec.name, domain=domain, rtf=rtf or _("max")))
     notes: list[str] = []
     warned: set[object] = set()
-    try:
+    try:  # a stop while saying so (a closed pipe) also ends the run as Ctrl-C would
+        click.echo(_("World {name} on ROS domain {domain}, RTF {rtf}. Ctrl-C stops.").format(
+            name=spec.name, domain=domain, rtf=rtf or _("max")))
         if companion is not None:
             bridge.pause()  # simulation time starts only once the companion is up
         bridge.start()

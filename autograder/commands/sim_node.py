@@ -25,8 +25,8 @@ from __future__ import annotations
 import dataclasses
 import functools
 import inspect
+import os
 import shutil
-import tempfile
 from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -34,7 +34,9 @@ from typing import TYPE_CHECKING, Any
 import click
 from click.core import ParameterSource
 
+from autograder.commands import stale
 from autograder.commands.exits import GraderFault, UsageProblem
+from autograder.commands.stale import hand_folder
 from autograder.core.errors import ContentError
 from autograder.core.output import describe_exit
 from autograder.i18n import _
@@ -67,6 +69,7 @@ class NodeRun:
     params: tuple[str, ...] = ()  # "name:=value", as given to --ros-args -p
     process: StudentProcess | None = None
     _folder: Path | None = None
+    _folder_lock: int | None = None  # held while the run lives: its folder is not stale
     _bridge: SimBridge | None = None
     _ended_at: float | None = None
 
@@ -84,8 +87,8 @@ class NodeRun:
         from autograder.sandbox.process import LaunchFailed, student_process
 
         self._bridge = bridge
-        self._folder = Path(tempfile.mkdtemp(prefix="autograder-hand-"))
         name = self.exercise.file if self.exercise is not None else self.script.name
+        self._folder, self._folder_lock = hand_folder(name)
         staged = stage(self.script, name, self._folder / "staged")
         course = self.exercise.folder.parent.parent if self.exercise else self._folder
         args = ["-p", "use_sim_time:=true"]
@@ -156,6 +159,9 @@ class NodeRun:
                     how=describe_exit(status), t=self._ended_at))
         if self._folder is not None:
             shutil.rmtree(self._folder, ignore_errors=True)
+        if self._folder_lock is not None:
+            os.close(self._folder_lock)
+            self._folder_lock = None
         return notes
 
 
@@ -189,6 +195,32 @@ def exercise_world(exercise: Exercise) -> str:
     """The exercise's world as ``sim run --world`` takes it (a file in its folder by path)."""
     local = exercise.folder / exercise.world
     return str(local) if local.suffix in (".yaml", ".yml") and local.exists() else exercise.world
+
+
+def _clear_domain(given: int | None) -> int:
+    """The domain the hand run takes: ``given`` (else ``$ROS_DOMAIN_ID``, else 0), with
+    the student's nodes left there by a hand run that did not end stopped; a free one
+    instead where another user's are (only they may stop them). The student is told."""
+    domain = int(os.environ.get("ROS_DOMAIN_ID", "0")) if given is None else given
+    nodes = stale.find(domain)
+    mine = [node for node in nodes if node.uid == os.getuid()]
+    if mine:
+        stale.stop(mine)
+        for node in mine:
+            click.echo(_("A node of yours ({file}, pid {pid}) was still running on ROS domain "
+                         "{domain}, left by a hand run that did not end; it got the same "
+                         "commands as this run's node, so it is stopped now.").format(
+                file=node.script or "?", pid=node.pid, domain=domain), err=True)
+    if len(mine) < len(nodes):
+        free = stale.free_domain(domain)
+        if free is not None:
+            click.echo(_("Another user's node, left by a hand run, is on ROS domain "
+                         "{domain}, and only they can stop it: this run uses domain {free} "
+                         "instead. Give the same domain to your other terminals: "
+                         "`autograder sim drive --domain {free}`, `export "
+                         "ROS_DOMAIN_ID={free}`.").format(domain=domain, free=free), err=True)
+            return free
+    return domain
 
 
 def _stdout_writer() -> Callable[[bytes], None]:
@@ -254,6 +286,7 @@ def add_node_options(run: click.Command) -> None:
                 kwargs["world_name"] = exercise_world(found)
             if ctx.get_parameter_source("clock_hz") is ParameterSource.DEFAULT:
                 kwargs["clock_hz"] = found.clock_hz
+        kwargs["domain"] = _clear_domain(kwargs.get("domain"))
         ctx.meta[COMPANION] = NodeRun(node_file, found, echo=_stdout_writer(), params=params)
         return original(**kwargs)
 
