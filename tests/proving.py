@@ -10,6 +10,8 @@ as an exact set::
     loses: [test_clamps_linear, test_speed_stays_under_limit]
     says:                   # optional: what a lost test's message or hint must name
       test_clamps_linear: ["linear.x=3.0 was passed on unclamped"]
+    not_says:               # optional: advice it must not give (the variant follows it)
+      test_clamps_linear: ["declare_parameter"]
 
 and the program is either the exercise's file itself (an alternative correct design,
 written its own way) or ``<file>.patch``: a unified diff against the exercise's reference
@@ -172,6 +174,9 @@ class Variant:
     # For a lost test, words its feedback (message or hint, in English) must contain: the
     # value or case that failed and the fix for it, not a generic reminder of the API.
     says: tuple[tuple[str, tuple[str, ...]], ...] = ()
+    # For a lost test, words its feedback must not contain: advice the variant already
+    # follows (a hint chosen from what was observed never repeats what the code does).
+    not_says: tuple[tuple[str, tuple[str, ...]], ...] = ()
 
     def program(self, exercise: Exercise) -> str:
         """The submitted file's text: the folder's own copy, or the patched solution."""
@@ -208,8 +213,9 @@ def load_variant(folder: Path, exercise: Exercise) -> Variant:
         raise wrong("missing: every submission folder says what it must lose")
     data = yaml.safe_load(path.read_text(encoding="utf-8"))
     if not isinstance(data, dict) or not {"kind", "why", "loses"} <= set(data) \
-            or set(data) - {"kind", "why", "loses", "may_also_lose", "says"}:
-        raise wrong("needs the keys kind, why and loses (and may have may_also_lose, says)")
+            or set(data) - {"kind", "why", "loses", "may_also_lose", "says", "not_says"}:
+        raise wrong("needs the keys kind, why and loses (and may have may_also_lose, says, "
+                    "not_says)")
     kind, why, loses = data["kind"], data["why"], data["loses"]
     may = data.get("may_also_lose", [])
     if not isinstance(may, list) or not all(isinstance(t, str) for t in may) \
@@ -228,18 +234,21 @@ def load_variant(folder: Path, exercise: Exercise) -> Variant:
     unknown = (set(loses) | set(may)) - exercise_tests(exercise)
     if unknown:
         raise wrong(f"no such tests in {exercise.id}: {', '.join(sorted(unknown))}")
-    says = data.get("says", {})
-    if not isinstance(says, dict) or not set(says) <= set(loses) or not all(
-            isinstance(words, list) and words
-            and all(isinstance(w, str) and w.strip() for w in words)
-            for words in says.values()):
-        raise wrong("says maps tests in loses to lists of words their feedback names")
+    says, not_says = data.get("says", {}), data.get("not_says", {})
+    for key, words_of in (("says", says), ("not_says", not_says)):
+        if not isinstance(words_of, dict) or not set(words_of) <= set(loses) or not all(
+                isinstance(words, list) and words
+                and all(isinstance(w, str) and w.strip() for w in words)
+                for words in words_of.values()):
+            raise wrong(f"{key} maps tests in loses to lists of words their feedback "
+                        f"{'names' if key == 'says' else 'must not name'}")
     files = [p for p in (folder / exercise.file, folder / f"{exercise.file}.patch")
              if p.exists()]
     if len(files) != 1:
         raise wrong(f"needs {exercise.file} or {exercise.file}.patch, and only one")
     return Variant(folder.name, folder, kind, why.strip(), frozenset(loses), frozenset(may),
-                   tuple((test, tuple(words)) for test, words in sorted(says.items())))
+                   tuple((test, tuple(words)) for test, words in sorted(says.items())),
+                   tuple((test, tuple(words)) for test, words in sorted(not_says.items())))
 
 
 def load_variants(exercise: Exercise) -> dict[str, Variant]:
@@ -386,14 +395,28 @@ def test_known_bad_variant_passes_only_with_every_core_test(
 
 def test_known_bad_variant_is_told_what_was_observed(
         graded: dict[str, RunResult], proof: Proof, known_bad: str) -> None:
-    """A lost test names the value or case that failed and its fix (``says``)."""
-    by_name = {t.name: t for t in graded[known_bad].tests}
-    missing = {test: [w for w in words
-                      if w not in f"{by_name[test].message}\n{by_name[test].hint}"]
-               for test, words in proof.variants[known_bad].says}
-    assert not any(missing.values()), {
-        test: {"missing": words, "message": by_name[test].message, "hint": by_name[test].hint}
-        for test, words in missing.items() if words}
+    """A lost test names the value or case that failed and its fix (``says``), and gives
+    no advice the variant already follows (``not_says``)."""
+    wrong = feedback_mismatches(graded[known_bad], proof.variants[known_bad])
+    assert not wrong, explain(**wrong)
+
+
+def feedback_mismatches(result: RunResult, variant: Variant) -> dict[str, Any]:
+    """For each lost test, the ``says`` words its feedback lacks and the ``not_says`` words
+    it has (empty: the feedback fits the variant)."""
+    by_name = {t.name: t for t in result.tests}
+    wrong: dict[str, Any] = {}
+    checks = [(test, words, False) for test, words in variant.says] + \
+        [(test, words, True) for test, words in variant.not_says]
+    for test, words, present in checks:
+        found = by_name.get(test)
+        text = f"{found.message}\n{found.hint}" if found else ""
+        bad = [w for w in words if (w in text) == present]
+        if bad:
+            entry = wrong.setdefault(test, {"message": found.message if found else None,
+                                            "hint": found.hint if found else None})
+            entry["says, though it must not" if present else "missing"] = bad
+    return wrong
 
 
 def test_each_hint_is_given_once(graded: dict[str, RunResult]) -> None:

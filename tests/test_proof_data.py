@@ -91,12 +91,36 @@ def expectation(tmp_path: Path, text: str) -> Path:
      "says maps tests in loses"),
     ("kind: mutant\nwhy: x\nloses: [test_node_starts]\nsays: [test_node_starts]\n",
      "says maps tests in loses"),
+    ("kind: mutant\nwhy: x\nloses: [test_node_starts]\nnot_says: {test_clamps_linear: [a]}\n",
+     "not_says maps tests in loses"),
+    ("kind: mutant\nwhy: x\nloses: [test_node_starts]\nnot_says: {test_node_starts: []}\n",
+     "not_says maps tests in loses"),
 ])
 def test_a_malformed_expectation_is_refused(tmp_path: Path, text: str, problem: str) -> None:
     """A typo must not quietly weaken a proof."""
     folder = expectation(tmp_path, text)
     with pytest.raises(ValueError, match=problem):
         load_variant(folder, find_exercise("parameter_validation"))
+
+
+def test_feedback_must_name_what_says_lists_and_nothing_not_says_lists(
+        tmp_path: Path) -> None:
+    """``says`` words missing and ``not_says`` words present are both reported, each
+    under its test; feedback that fits reports nothing."""
+    folder = expectation(tmp_path, "kind: mutant\nwhy: x\nloses: [test_node_starts]\n"
+                         "says: {test_node_starts: [observed]}\n"
+                         "not_says: {test_node_starts: [already done, MultiThreadedExecutor]}\n")
+    variant = load_variant(folder, find_exercise("parameter_validation"))
+
+    def graded(message: str, hint: str) -> SimpleNamespace:
+        return SimpleNamespace(tests=[SimpleNamespace(name="test_node_starts",
+                                                      message=message, hint=hint)])
+
+    assert proving.feedback_mismatches(graded("what was observed", "fix it"), variant) == {}
+    wrong = proving.feedback_mismatches(
+        graded("nothing", "spin a MultiThreadedExecutor"), variant)["test_node_starts"]
+    assert wrong["missing"] == ["observed"]
+    assert wrong["says, though it must not"] == ["MultiThreadedExecutor"]
 
 
 def test_a_folder_with_both_a_file_and_a_patch_is_refused(tmp_path: Path) -> None:

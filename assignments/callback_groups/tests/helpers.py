@@ -34,10 +34,17 @@ class Answer:
     sent: float
     answered: float | None = None
     response: Any = None
+    # The same two moments in wall time (monotonic): how a wait was timed shows in them.
+    sent_wall: float = 0.0
+    answered_wall: float | None = None
 
     @property
     def latency(self) -> float | None:
         return None if self.answered is None else self.answered - self.sent
+
+    @property
+    def wall_latency(self) -> float | None:
+        return None if self.answered_wall is None else self.answered_wall - self.sent_wall
 
 
 def ahead(scan: Any) -> list[float]:
@@ -77,7 +84,7 @@ class Requests:
         return self.probe.wait_for(self.client.service_is_ready, sim_timeout)
 
     def send(self) -> Answer:
-        answer = Answer(sent=self.probe.now)
+        answer = Answer(sent=self.probe.now, sent_wall=time.monotonic())
         future = self.client.call_async(Trigger.Request())
 
         def done(f: Any, a: Answer = answer) -> None:
@@ -87,6 +94,7 @@ class Requests:
                 response = None
             with self._lock:
                 a.answered = self.probe.now
+                a.answered_wall = time.monotonic()
                 a.response = response
 
         future.add_done_callback(done)
@@ -134,11 +142,26 @@ def require_alive(alive: bool) -> None:
 
 
 def deadlock_hint() -> str:
-    return _("A callback that waits blocks its callback group, and in a single-threaded "
-             "executor the whole node, /clock included: the scan it waits for can never "
-             "arrive. Put the service and the scan subscription in different callback "
-             "groups and spin a MultiThreadedExecutor (not Jazzy's experimental "
-             "EventsExecutor, which ignores callback groups).")
+    """No answer at all: the request's wait held back the scan callback and /clock."""
+    return _("A service callback that waits, or an async def one that awaits, holds its "
+             "callback group until it returns: a scan callback or /clock subscription in "
+             "the same group (the node's default group, unless you give one) cannot run, "
+             "so the scan it waits for never arrives and ROS time stops for the node. Give "
+             "the service a callback group of its own: with a waiting callback, spin a "
+             "MultiThreadedExecutor (not Jazzy's experimental EventsExecutor, which "
+             "ignores callback groups); with the README's async def design, a "
+             "ReentrantCallbackGroup on the single thread is enough.")
+
+
+def held_back_hint() -> str:
+    """An answer after the whole wait though scans kept coming: none reached the node's
+    scan callback meanwhile, so something held it back (a group shared with the
+    service)."""
+    return _("No scan reached the scan callback while the request waited, though the world "
+             "published one every 0.1 s: the waiting service callback held it back. A "
+             "MutuallyExclusiveCallbackGroup runs one of its callbacks at a time, so the "
+             "service and the scan subscription must not share one: give the service a "
+             "callback group of its own.")
 
 
 def first_scan_after(scans: Any, stamp: float) -> Any:
@@ -166,7 +189,10 @@ def judge(answer: Answer, scan: Any, where: str) -> None:
             _("{where}, check_path answered after {latency:.2f} s of simulation time "
               "({message!r}), though a scan came every 0.1 s.").format(
                 where=where, latency=answer.latency, message=response.message),
-            deadlock_hint())
+            # Without the distance the scan held, it found no fresh scan in the whole wait.
+            held_back_hint() if not _gives(response.message, expected) else
+            _("Answer as soon as the first scan newer than the request arrives; the 1.0 s "
+              "is the longest wait, for when no scan comes."))
     if response.success != clear:
         raise StudentFailure(
             _("{where}, check_path answered success={got} ({message!r}), but the nearest "
@@ -175,14 +201,19 @@ def judge(answer: Answer, scan: Any, where: str) -> None:
                 where=where, got=response.success, message=response.message,
                 nearest=expected if expected is not None else float("inf"), want=clear),
             _success_hint(scan, expected, response.success))
-    if expected is not None and not any(abs(n - expected) <= DISTANCE_TOLERANCE
-                                        for n in numbers(response.message)):
+    if expected is not None and not _gives(response.message, expected):
         raise StudentFailure(
             _("{where}, check_path's message was {message!r}; it must give the nearest "
               "distance ahead, {nearest:.2f} m.").format(
                 where=where, message=response.message, nearest=expected),
             _("Put the distance in the message, e.g. f'nearest obstacle ahead: "
               "{{nearest:.2f}} m'.").format())
+
+
+def _gives(message: str, distance: float | None) -> bool:
+    """Whether ``message`` names ``distance`` (as an answer from that scan does)."""
+    return distance is not None and any(abs(n - distance) <= DISTANCE_TOLERANCE
+                                        for n in numbers(message))
 
 
 def _success_hint(scan: Any, nearest: float | None, said: bool) -> str:
