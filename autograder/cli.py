@@ -483,7 +483,7 @@ def grade_batch(item: str, submissions: Path, jobs: int | str, csv_path: Path, o
     try:
         share = parse_shard(shard) if shard else None
     except ValueError:
-        raise UsageProblem(_("--shard must be I/N with 1 <= I <= N, got {value}").format(
+        raise UsageProblem(_("--shard must be I/N with `1 <= I <= N`, got {value}").format(
             value=shard)) from None
     out = out or Path("grades") / item
     if jobs == "auto" and _exercise_or_none(item) is None:

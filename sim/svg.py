@@ -14,6 +14,7 @@ from collections.abc import Sequence
 from html import escape
 
 from sim.i18n import _
+from sim.legend import legend_height, legend_svg
 from sim.physics import box_corners, describe
 from sim.recorder import Recording
 from sim.worldfile import ROBOT_RADIUS, Goal, WorldSpec, title_of
@@ -39,16 +40,17 @@ def scene_svg(spec: WorldSpec, recordings: Sequence[Recording], goal: Goal | Non
     """The SVG text for several runs in one arena: each run's path, end pose and
     collisions in a group ``<g class="run" data-run="i">``, collisions carrying their time
     (``data-t``); ``overlay`` is markup drawn on top, in world coordinates (a replay's
-    moving parts)."""
+    moving parts). Below the arena, a legend and a scale bar (:mod:`sim.legend`)."""
     w, h = spec.size
     goal = goal or spec.goal
     margin = 0.1
+    band = legend_height(w + 2 * margin - 0.1, goal is not None, len(recordings), bool(overlay))
     parts = [
         f'<svg xmlns="http://www.w3.org/2000/svg" class="sim-trajectory" '
         f'width="{_num((w + 2 * margin) * _PX_PER_M)}" '
-        f'height="{_num((h + 2 * margin) * _PX_PER_M)}" '
+        f'height="{_num((h + 2 * margin + band) * _PX_PER_M)}" '
         f'viewBox="{_num(-margin)} {_num(-margin)} {_num(w + 2 * margin)} '
-        f'{_num(h + 2 * margin)}" role="img">',
+        f'{_num(h + 2 * margin + band)}" role="img">',
         f"<title>{escape(title_of(spec))}</title>",
         f'<g transform="translate(0 {_num(h)}) scale(1 -1)">',
         f'<rect x="0" y="0" width="{_num(w)}" height="{_num(h)}" fill="#fafafa"/>',
@@ -73,7 +75,10 @@ def scene_svg(spec: WorldSpec, recordings: Sequence[Recording], goal: Goal | Non
         parts += _run(spec, recording, i if len(recordings) > 1 else None)
     if overlay:
         parts.append(overlay)
-    parts.append("</g></svg>")
+    parts.append("</g>")
+    parts.append(legend_svg(h + margin, -margin + 0.05, w + 2 * margin - 0.1,
+                            goal is not None, len(recordings), bool(overlay)))
+    parts.append("</svg>")
     return "\n".join(parts)
 
 

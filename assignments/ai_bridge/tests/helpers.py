@@ -156,10 +156,10 @@ def judge_reached(mission: Mission, credit: Any, world_name: str) -> None:
         if last is not None and abs(last.v) < STILL and abs(last.w) < 5 * STILL:
             hint = _("It stood still outside {reached} m of the goal, which is not arriving: "
                      "drive on until the odometry puts you within {reached} m of "
-                     "(goal_x, goal_y), then stop.").format(reached=REACHED)
+                     "`(goal_x, goal_y)`, then stop.").format(reached=REACHED)
         else:
             hint = _("Stop (a zero Twist) once the odometry puts you within 0.3 m of "
-                     "(goal_x, goal_y); is the goal read from the parameters?")
+                     "`(goal_x, goal_y)`; is the goal read from the parameters?")
     credit.award(min(progress, 0.99), message, hint)
 
 

@@ -116,7 +116,7 @@ def require_service(requests: Requests) -> None:
     if not requests.ready():
         raise StudentFailure(
             _("No check_path service appeared within 5 s of simulation time."),
-            _("Create it with self.create_service(Trigger, 'check_path', callback)."))
+            _("Create it with `self.create_service(Trigger, 'check_path', callback)`."))
 
 
 def ask(probe: Any, sim_timeout: float = 3.0) -> Answer:
@@ -195,7 +195,7 @@ def judge(answer: Answer, scan: Any, where: str) -> None:
               "is the longest wait, for when no scan comes."))
     if response.success != clear:
         raise StudentFailure(
-            _("{where}, check_path answered success={got} ({message!r}), but the nearest "
+            _("{where}, check_path answered `success={got}` ({message!r}), but the nearest "
               "valid reading within 30 degrees of straight ahead was {nearest:.2f} m, so "
               "success must be {want}.").format(
                 where=where, got=response.success, message=response.message,
@@ -221,20 +221,20 @@ def _success_hint(scan: Any, nearest: float | None, said: bool) -> str:
     invalid = [r for r in ahead(scan) if not valid(scan, r)] if scan is not None else []
     if not said and invalid:
         return ngettext(
-            "{count} reading ahead was invalid (NaN, +-inf, or outside [{low}, {high}] m): "
+            "{count} reading ahead was invalid (NaN, +-inf, or outside `[{low}, {high}]` m): "
             "it is no obstacle. Skip a reading unless it is finite and within "
-            "[range_min, range_max].",
-            "{count} readings ahead were invalid (NaN, +-inf, or outside [{low}, {high}] m): "
+            "`[range_min, range_max]`.",
+            "{count} readings ahead were invalid (NaN, +-inf, or outside `[{low}, {high}]` m): "
             "they are no obstacle. Skip a reading unless it is finite and within "
-            "[range_min, range_max].", len(invalid)).format(
+            "`[range_min, range_max]`.", len(invalid)).format(
             count=len(invalid), low=scan.range_min, high=scan.range_max)
     if said and nearest is not None:
         return _("{nearest:.2f} m ahead is under 0.5 m, yet the path was called clear: it is "
                  "clear only when every valid reading within +-30 degrees is at least 0.5 m. "
                  "Check your threshold.").format(nearest=nearest)
-    return _("Use only readings that are finite and within [range_min, range_max], at "
-             "angles within +-30 degrees of straight ahead (wrap angle_min + i * "
-             "angle_increment into [-pi, pi]); success means all of them are at least "
+    return _("Use only readings that are finite and within `[range_min, range_max]`, at "
+             "angles within +-30 degrees of straight ahead (wrap "
+             "`angle_min + i * angle_increment` into `[-pi, pi]`); success means all of them are at least "
              "0.5 m.")
 
 

@@ -116,8 +116,8 @@ def exception_hint(output: str) -> str:
     error = raised(output)
     if error:
         return _("It raised {error}: catch exceptions inside your callbacks, log them with "
-                 "get_logger().error(...), publish a stop and carry on.").format(error=error)
-    return _("Catch exceptions inside your callbacks: log them with get_logger().error(...), "
+                 "`get_logger().error(...)`, publish a stop and carry on.").format(error=error)
+    return _("Catch exceptions inside your callbacks: log them with `get_logger().error(...)`, "
              "publish a stop and carry on.")
 
 
@@ -158,7 +158,7 @@ def settle_forward(probe: Any, inbox: Any, feeder: ScanFeeder, node: Any) -> flo
         alive(probe, inbox, node, _("while it was shown a clear way ahead"))
         last = inbox.messages[-1:] or None
         raise StudentFailure(
-            _("With nothing nearer than 2 m, cmd_vel never said linear.x={v}, angular.z=0 "
+            _("With nothing nearer than 2 m, cmd_vel never said `linear.x={v}, angular.z=0` "
               "within 2 s (last command: {last}).").format(
                 v=FORWARD, last=describe(last[0]) if last else _("none")),
             _("Publish from a 10 Hz timer: forward at 0.2 m/s when the nearest valid reading "

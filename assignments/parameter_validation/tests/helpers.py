@@ -41,7 +41,7 @@ def exchange(probe, inbox, wish: Twist) -> list[Twist]:
     probe.publish(Twist, "agent/cmd_vel", wish)
     if not probe.wait_for(lambda: len(inbox) > before, 2.0):
         raise StudentFailure(
-            _("The agent asked for linear.x={x}, angular.z={z} on agent/cmd_vel, and nothing "
+            _("The agent asked for `linear.x={x}, angular.z={z}` on agent/cmd_vel, and nothing "
               "came on cmd_vel within 2 s of simulation time.").format(
                 x=wish.linear.x, z=wish.angular.z),
             _("Publish one cmd_vel message from the agent/cmd_vel callback. Is the node "

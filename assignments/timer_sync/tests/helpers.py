@@ -213,7 +213,7 @@ def no_plan_hint(run: Run) -> str:
     counted = max((s["plans"] for s in map(parse_status, (m for _t, m in run.statuses))
                    if s is not None), default=0)
     if counted > len(run.plan_times()):
-        return _("status reported plans={counted}, so the planner runs, but its routes do "
+        return _("status reported `plans={counted}`, so the planner runs, but its routes do "
                  "not come on plan: publish each one there as a std_msgs/String.").format(
             counted=counted)
     return _("Create a 10 s timer that calls plan_route() and publishes the result on plan.")
@@ -253,7 +253,7 @@ def too_fast(count: int, seconds: float, hz: float) -> bool:
 
 
 def wall_clock_hint() -> str:
-    return _("Make every timer with self.create_timer(period, callback) and no clock= "
+    return _("Make every timer with `self.create_timer(period, callback)` and no clock= "
              "argument, and read time with self.get_clock(): with use_sim_time they follow "
              "/clock, whatever its pace. A Clock() made by hand (ClockType.STEADY_TIME or "
              "SYSTEM_TIME), time.sleep and time.time keep the wall clock.")

@@ -102,7 +102,7 @@ def _concurrency_hint(answers: list) -> str:
 
 @pytest.mark.points(1)
 def test_no_fresh_scan(student, probe, world, alive):
-    """Without a scan for 3 s, check_path answers success=false after waiting 1.0 s"""
+    """Without a scan for 3 s, check_path answers `success=false` after waiting 1.0 s"""
     require_alive(alive)
     start = probe.now
     world.inject(Fault(kind="dropout", start=start, end=start + 3.0))
@@ -114,16 +114,16 @@ def test_no_fresh_scan(student, probe, world, alive):
     response = answer.response
     if response is None or response.success:
         raise StudentFailure(
-            _("With no scan coming, check_path answered success={got} ({message!r}); the "
+            _("With no scan coming, check_path answered `success={got}` ({message!r}); the "
               "path cannot be confirmed clear, so success must be false.").format(
                 got=getattr(response, "success", None),
                 message=getattr(response, "message", "")),
             _("It answered {latency:.2f} s after the request, so from a scan older than the "
               "request: wait up to 1.0 s of ROS time for a scan that arrives after it, and "
-              "answer success=False when none comes.").format(latency=answer.latency)
+              "answer `success=False` when none comes.").format(latency=answer.latency)
             if response is not None and answer.latency < 0.5 else
             _("Answer only from a scan that arrives after the request; when none comes "
-              "within 1.0 s, say so with success=False."))
+              "within 1.0 s, say so with `success=False`."))
     # 1.0 s of ROS time is asked for; a wall-clock wait of 1.0 s is let pass (sim time
     # may run slower than the wall on a busy machine), an answer without waiting is not.
     if not 0.5 <= answer.latency <= 1.5:

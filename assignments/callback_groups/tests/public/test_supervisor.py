@@ -73,7 +73,7 @@ def test_scan_rate(student, probe, scans, rates, alive, evidence):
 
 @pytest.mark.points(2)
 def test_open_space(student, probe, scans, alive):
-    """check_path answers success=true with the nearest distance in open space"""
+    """check_path answers `success=true` with the nearest distance in open space"""
     require_alive(alive)
     answer = ask(probe)
     judge(answer, scan_after(probe, scans, answer.sent),
@@ -86,7 +86,7 @@ def test_open_space(student, probe, scans, alive):
 
 @pytest.mark.points(2)
 def test_box_ahead(student, probe, scans, world, alive):
-    """check_path answers success=false with the distance when a box is 0.4 m ahead"""
+    """check_path answers `success=false` with the distance when a box is 0.4 m ahead"""
     require_alive(alive)
     # The scans after the time it was added at show the box; one published by a tick
     # that was under way when it was added may not.

@@ -227,7 +227,7 @@ def test_log_not_flooded(run, student):
                 _("The lidar was silent for {span:.0f} s ({seconds:.1f} s into the run) and "
                   "the node logged no warning.").format(
                     span=d.end - d.start, seconds=d.start - run.start),
-                _("Log it: self.get_logger().warn('no scan ...', throttle_duration_sec=1.0)."))
+                _("Log it: `self.get_logger().warn('no scan ...', throttle_duration_sec=1.0)`."))
         if count > allowed:
             raise StudentFailure(
                 ngettext("The lidar was silent for {span:.0f} s and the node logged {count} "
@@ -235,4 +235,4 @@ def test_log_not_flooded(run, student):
                          "The lidar was silent for {span:.0f} s and the node logged {count} "
                          "warnings; at most about one a second ({allowed}) is useful.",
                          count).format(span=d.end - d.start, count=count, allowed=allowed),
-                _("Throttle the warning: get_logger().warn(..., throttle_duration_sec=1.0)."))
+                _("Throttle the warning: `get_logger().warn(..., throttle_duration_sec=1.0)`."))

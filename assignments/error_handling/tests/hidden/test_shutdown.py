@@ -27,7 +27,7 @@ EXIT_WITHIN = 5.0
 # after it would be taken within milliseconds.  0.5 s of it made six trials' quiet a third
 # of the module's wall time.
 ARRIVE_WITHIN, STRAGGLERS = 3.0, 0.2
-HINT = _("Use rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO), spin an "
+HINT = _("Use `rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)`, spin an "
          "executor in a thread, wait on a threading.Event set by your own SIGINT/SIGTERM "
          "handlers, then stop spinning, publish Twist(), wait_for_all_acked, destroy the node "
          "and return 0 (see the README).")

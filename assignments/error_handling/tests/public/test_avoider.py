@@ -57,7 +57,7 @@ def avoider(feeder, student, start_node, probe, commands):
     if not probe.wait_for_subscriber(LaserScan, "/scan", 5.0):
         raise StudentFailure(
             _("Nothing subscribes to scan."),
-            _("Create a subscription: self.create_subscription(LaserScan, 'scan', ...)."))
+            _("Create a subscription: `self.create_subscription(LaserScan, 'scan', ...)`."))
     return node
 
 
@@ -77,9 +77,9 @@ def test_publishes_at_10_hz(avoider, feeder, probe, commands):
                      "In 3 s of simulation time cmd_vel was published {count} times; a 10 Hz "
                      "timer gives 30.", count).format(count=count),
             _("That is more than once a cycle: publish only from the timer of "
-              "self.create_timer(0.1, ...), not from the scan callback as well.") if count > 36
+              "`self.create_timer(0.1, ...)`, not from the scan callback as well.") if count > 36
             else _("That is less than once a cycle: publish on every cycle of "
-                   "self.create_timer(0.1, ...), a stop included, not only from the scan "
+                   "`self.create_timer(0.1, ...)`, a stop included, not only from the scan "
                    "callback or when something changes."))
 
 
@@ -92,10 +92,10 @@ def test_drives_when_clear(avoider, feeder, probe, commands):
     wrong = [m for m in window(commands, start, probe.now) if not is_forward(m)]
     if wrong:
         raise StudentFailure(
-            _("With a clear way ahead cmd_vel said {got}; expected linear.x={v}, "
-              "angular.z=0 on every cycle.").format(got=describe(wrong[0]), v=FORWARD),
+            _("With a clear way ahead cmd_vel said {got}; expected "
+              "`linear.x={v}, angular.z=0` on every cycle.").format(got=describe(wrong[0]), v=FORWARD),
             _("Nothing was nearer than 2 m: with no valid reading within ±30° of ahead at "
-              "0.6 m or nearer, publish linear.x=0.2, angular.z=0 on every cycle."))
+              "0.6 m or nearer, publish `linear.x=0.2, angular.z=0` on every cycle."))
 
 
 @pytest.mark.points(2)
@@ -108,13 +108,13 @@ def test_turns_toward_room(avoider, feeder, probe, commands):
         if turned is None or turn_of(turned) != toward:
             raise StudentFailure(
                 _("An obstacle 0.4 to 0.55 m ahead, open space on the {side}: cmd_vel said {got}; "
-                  "expected linear.x=0, angular.z={z}.").format(
+                  "expected `linear.x=0, angular.z={z}`.").format(
                     side=side, got=describe(turned) if turned else _("nothing new"),
                     z=toward * TURN),
                 _("It turned toward the nearer side: sum or average the valid readings on the "
-                  "left (bearings 0 to 180°, angular.z > 0) and on the right, and turn toward "
+                  "left (bearings 0 to 180°, `angular.z > 0`) and on the right, and turn toward "
                   "the larger.") if turned is not None and turn_of(turned) == -toward else
-                _("Turn in place (linear.x=0) at ±0.5 rad/s, positive to the left, toward "
+                _("Turn in place (`linear.x=0`) at ±0.5 rad/s, positive to the left, toward "
                   "the side whose valid readings are farther."))
 
 
@@ -156,9 +156,9 @@ def test_watchdog_stops(avoider, feeder, probe, commands):
 def test_rejects_malformed_scans(avoider, feeder, probe, commands):
     """An empty scan, or one whose length disagrees with its angles, gives a stop"""
     hints = (_("An empty ranges list shows no obstacle, but no open way either: stop when "
-               "len(scan.ranges) == 0."),
+               "`len(scan.ranges) == 0`."),
              _("Its angles say 360 beams and it held 180: before using a scan, check "
-               "len(ranges) == round((angle_max - angle_min) / angle_increment) + 1, and stop "
+               "`len(ranges) == round((angle_max - angle_min) / angle_increment) + 1`, and stop "
                "when it differs."))
     for (bad, what), hint in zip(
             ((make_scan(count=0), _("an empty scan")),
@@ -176,8 +176,8 @@ def test_rejects_malformed_scans(avoider, feeder, probe, commands):
                   "cycle.").format(what=what, got=describe(going[0]) if going else
                                    _("nothing")),
                 hint if going else
-                _("Before using a scan, check len(ranges) against (angle_max - angle_min) / "
-                  "angle_increment + 1; reject an empty or mismatched scan with a stop."))
+                _("Before using a scan, check `len(ranges)` against "
+                  "`(angle_max - angle_min) / angle_increment + 1`; reject an empty or mismatched scan with a stop."))
     settle_forward(probe, commands, feeder, avoider)
 
 
@@ -211,7 +211,7 @@ def test_ignores_invalid_readings(avoider, feeder, probe, commands):
             _("Ahead were only NaN, inf, -inf, 0.05 m (below range_min) and 9 m (above "
               "range_max) readings, the rest 2 m away: cmd_vel said {got}; expected forward "
               "at {v} m/s.").format(got=describe(wrong[0]), v=FORWARD),
-            _("Skip a reading unless range_min <= r <= range_max (false for NaN and inf)."))
+            _("Skip a reading unless `range_min <= r <= range_max` (false for NaN and inf)."))
     since = feeder.feed(make_scan(_hidden_obstacle))
     turned = wait_command(probe, commands, since, lambda m: turn_of(m) != 0, 1.0)
     alive(probe, commands, avoider, _("after a scan with NaN readings"))
@@ -242,6 +242,6 @@ def test_survives_exceptions(avoider, feeder, probe, commands):
                   "directions to judge. Check angle_increment (and the length of ranges) "
                   "before use, and stop for that cycle.") if going else
                 _("Wrap the work of each callback in try/except Exception: log the error "
-                  "with get_logger().error(...) and publish Twist()."))
+                  "with `get_logger().error(...)` and publish Twist()."))
     settle_forward(probe, commands, feeder, avoider)
     alive(probe, commands, avoider, _("after the scans it could not use"))

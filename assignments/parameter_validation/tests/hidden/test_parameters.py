@@ -62,7 +62,7 @@ def test_refuses_out_of_range(student, probe, commands):
         reason = refused(probe, name, value)
         if name not in reason:
             raise StudentFailure(
-                _("Refusing {name}={value} said {reason!r}, which does not name {name}.")
+                _("Refusing `{name}={value}` said {reason!r}, which does not name {name}.")
                 .format(name=name, value=value, reason=reason),
                 _("Put the parameter's name in the reason, e.g. '{example}'.").format(
                     example=example_reason(name, value)))
@@ -78,12 +78,12 @@ def _after_refusals_hint(got: float, refused_values: list[float]) -> str:
     """Which limit the answer to 3.0 m/s fits: a refused value, or none (not clamped)."""
     if close(got, 3.0):
         return _("3.0 is what the agent asked for: either linear.x is not clamped, or the "
-                 "refused max_linear_speed=3.0 became the limit. Clamp with "
+                 "refused `max_linear_speed=3.0` became the limit. Clamp with "
                  "`max(-limit, min(limit, value))`, and change the limits only once every "
                  "parameter of a set has passed.")
     taken = [v for v in refused_values if close(clamp(3.0, v), got)]
     if taken:
-        return _("That fits max_linear_speed={value}, a value that was refused: change the "
+        return _("That fits `max_linear_speed={value}`, a value that was refused: change the "
                  "limits your callback uses only once every parameter of a set has "
                  "passed.").format(value=taken[0])
     return clamp_hint("linear.x", "max_linear_speed", 0.5, 3.0, got)
@@ -123,7 +123,7 @@ def test_accepted_value_applies(student, probe, commands):
             raise StudentFailure(
                 _("Setting {name} to {value}, inside its range, was refused: {reason}")
                 .format(name=name, value=value, reason=result.reason),
-                _("{value} lies within [{low}, {high}], the bounds included: refuse only "
+                _("{value} lies within `[{low}, {high}]`, the bounds included: refuse only "
                   "values below {low} or above {high} (compare with `<` and `>`, not `<=` "
                   "and `>=`).").format(value=value, low=low, high=high))
         old, limits[name] = limits[name], value

@@ -46,15 +46,15 @@ def _still_running_hint(name: str, value: float,
         other, other_value = refused_before[0]
         if value < low:
             text = _("Started with -p {other}:={other_value} it did exit, so the starting "
-                     "values are checked, but {name}={value} got through: check the lower "
-                     "bound there too ({name} >= {low}).")
+                     "values are checked, but `{name}={value}` got through: check the lower "
+                     "bound there too (`{name} >= {low}`).")
         else:
             text = _("Started with -p {other}:={other_value} it did exit, so the starting "
-                     "values are checked, but {name}={value} got through: check the upper "
-                     "bound there too ({name} <= {high}).")
+                     "values are checked, but `{name}={value}` got through: check the upper "
+                     "bound there too (`{name} <= {high}`).")
         return text.format(other=other, other_value=other_value, name=name, value=value,
                            low=low, high=high)
     return _("declare_parameter applies the -p overrides before any on-set callback exists, "
-             "so your callback never saw {name}={value}. After declaring, check the "
+             "so your callback never saw `{name}={value}`. After declaring, check the "
              "starting values yourself, log an error naming {name} and return 1 from "
              "`main()`, ending the file with `sys.exit(main())`.").format(name=name, value=value)

@@ -21,7 +21,7 @@ def test_clamps_linear(student, probe, commands):
         got = answer(probe, commands, twist(linear_x=asked)).linear.x
         if not close(got, expected):
             raise StudentFailure(
-                _("The agent asked for linear.x={asked}; cmd_vel had linear.x={got}, "
+                _("The agent asked for `linear.x={asked}`; cmd_vel had `linear.x={got}`, "
                   "expected {expected} (max_linear_speed is 0.5).").format(
                     asked=asked, got=got, expected=expected),
                 clamp_hint("linear.x", "max_linear_speed", 0.5, asked, got))
@@ -35,7 +35,7 @@ def test_clamps_angular(student, probe, commands):
         got = answer(probe, commands, twist(angular_z=asked)).angular.z
         if not close(got, expected):
             raise StudentFailure(
-                _("The agent asked for angular.z={asked}; cmd_vel had angular.z={got}, "
+                _("The agent asked for `angular.z={asked}`; cmd_vel had `angular.z={got}`, "
                   "expected {expected} (max_angular_speed is 1.0).").format(
                     asked=asked, got=got, expected=expected),
                 clamp_hint("angular.z", "max_angular_speed", 1.0, asked, got))
@@ -49,9 +49,9 @@ def test_one_output_per_input(student, probe, commands):
         answers = exchange(probe, commands, twist(linear_x=asked))
         if len(answers) != 1:
             raise StudentFailure(
-                ngettext("The agent's linear.x={asked} gave {count} cmd_vel message; "
+                ngettext("The agent's `linear.x={asked}` gave {count} cmd_vel message; "
                          "expected exactly one.",
-                         "The agent's linear.x={asked} gave {count} cmd_vel messages; "
+                         "The agent's `linear.x={asked}` gave {count} cmd_vel messages; "
                          "expected exactly one.", len(answers)).format(
                     asked=asked, count=len(answers)),
                 _("Call publish() once per agent/cmd_vel message, from its callback only: "

@@ -52,7 +52,7 @@ def test_cruise_speed_override(probe, streams):
     wrong = [m.linear.x for m in commands.messages if abs(m.linear.x - SPEED) > 1e-6]
     if wrong:
         raise StudentFailure(
-            _("Started with -p cruise_speed:=0.35, cmd_vel had linear.x={got}.").format(
+            _("Started with -p cruise_speed:=0.35, cmd_vel had `linear.x={got}`.").format(
                 got=wrong[0]),
             _("Read the cruise_speed parameter (declare_parameter returns it) instead of a "
               "constant."))

@@ -42,7 +42,7 @@ def test_node_starts(student, probe, streams):
     wrong = [m.linear.x for m in commands.messages if abs(m.linear.x - CRUISE) > 1e-6]
     if wrong:
         raise StudentFailure(
-            _("cmd_vel had linear.x={got}; expected the cruise_speed parameter's default, "
+            _("cmd_vel had `linear.x={got}`; expected the cruise_speed parameter's default, "
               "{cruise}.").format(got=wrong[0], cruise=CRUISE),
             _("Declare cruise_speed with default 0.2 and publish its value as linear.x."))
 
@@ -124,9 +124,9 @@ def test_status_rate(run, evidence):
     if bad:
         raise StudentFailure(
             _("A status message was {text!r}; expected a JSON object with integer "
-              "control_ticks and plans, e.g. {{\"control_ticks\": 120, \"plans\": 1}}.")
+              "control_ticks and plans, e.g. `{{\"control_ticks\": 120, \"plans\": 1}}`.")
             .format(text=bad[0][:200]),
-            _("Build a dict and publish json.dumps(it) as the String's data."))
+            _("Build a dict and publish `json.dumps(it)` as the String's data."))
     require_not_frozen(run, _("the status rate"))
     times = [t for t, _m in items]
     evidence.intervals("status", times, STATUS_PERIOD + 0.1)
@@ -172,10 +172,10 @@ def test_status_counts(run):
         t, s = items[worst]
         seen = sum(1 for c in command_times if c <= t)
         raise StudentFailure(
-            ngettext("At t={t:.2f} s status said control_ticks={ticks}, but cmd_vel had come "
+            ngettext("At t={t:.2f} s status said `control_ticks={ticks}`, but cmd_vel had come "
                      "{seen} time by then; control_ticks must count every control callback "
                      "since the node started.",
-                     "At t={t:.2f} s status said control_ticks={ticks}, but cmd_vel had come "
+                     "At t={t:.2f} s status said `control_ticks={ticks}`, but cmd_vel had come "
                      "{seen} times by then; control_ticks must count every control callback "
                      "since the node started.", seen).format(
                 t=t, ticks=s["control_ticks"], seen=seen),
@@ -191,9 +191,9 @@ def test_status_counts(run):
         seen = sum(1 for p in plan_times if p <= t)
         if s["plans"] != seen:
             raise StudentFailure(
-                ngettext("At t={t:.2f} s status said plans={plans}, but {seen} plan had been "
+                ngettext("At t={t:.2f} s status said `plans={plans}`, but {seen} plan had been "
                          "published by then.",
-                         "At t={t:.2f} s status said plans={plans}, but {seen} plans had been "
+                         "At t={t:.2f} s status said `plans={plans}`, but {seen} plans had been "
                          "published by then.", seen).format(t=t, plans=s["plans"], seen=seen),
                 _("The node counts plans that never came on plan: publish each route on plan "
                   "(a std_msgs/String) when the planner finishes it, and count it then.")
