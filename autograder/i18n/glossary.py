@@ -24,7 +24,7 @@ from typing import Literal
 from babel.messages.catalog import Catalog, Message
 
 from autograder.core.errors import ContentError
-from autograder.i18n import _
+from autograder.i18n import _, rules
 from autograder.i18n.tools import Problem, read_catalog
 from sim.content import Document, build, load_document
 
@@ -72,6 +72,8 @@ class Term:
     forbid: tuple[str, ...] = ()
     allow: tuple[str, ...] = ()
     require: str | None = None
+    oblique: str | None = None
+    names: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         for name in ("en", "ur", "why"):
@@ -138,6 +140,12 @@ class Glossary:
         self.compounds = frozenset(_normal(c) for c in data.compounds)
         self.verbs = frozenset(v.lower() for v in data.latin_verbs)
         self.rules: list[_Rule] = []
+        self.gendered = tuple(
+            (word, term.gender, term.en) for term in data.terms if term.gender
+            for word in (term.ur, *term.names) if " " not in word)
+        self.oblique = tuple((term.ur, term.oblique) for term in data.terms if term.oblique)
+        self.nouns = frozenset(word for term in data.terms if term.gender and not term.latin
+                               for word in term.renderings)
         for i, term in enumerate(data.terms):
             self.rules.append(_Rule(
                 term, doc.line("terms", i) or 1,
@@ -153,9 +161,11 @@ class Glossary:
 
     # --- one text -------------------------------------------------------------------
     def problems(self, text: str, at: tuple[Path, int], en: str | None = None,
-                 keep: Iterable[str] = (), before: str = "") -> Iterator[Problem]:
+                 keep: Iterable[str] = (), before: str = "", grammar: bool = True
+                 ) -> Iterator[Problem]:
         """Problems of one translated ``text`` (``en``: its English, for ``require``;
-        ``before``: the end of the line before, when the text continues it)."""
+        ``before``: the end of the line before, when the text continues it; ``grammar``:
+        run the rules that read a whole sentence, which a README runs per paragraph)."""
         file, line = at
         kept = tuple(keep)
         ur = prose(text)
@@ -183,6 +193,21 @@ class Glossary:
                         renderings=", ".join(rule.term.renderings), glossary=self.path,
                         line=rule.line))
         yield from self._latin_runs(ur, file, line, prose(before))
+        if grammar:
+            yield from self.grammar(text, file, [line])
+
+    def grammar(self, text: str, file: Path, lines: list[int | None],
+                starts: list[int] | None = None) -> Iterator[Problem]:
+        """The language rules of :mod:`autograder.i18n.rules` on one translated text (a
+        README's paragraph: ``lines`` and the offsets where they ``starts`` in it)."""
+        found = [*rules.code_outside_spans(text, translated=True),
+                 *rules.polite_imperatives(prose(text)),
+                 *rules.agreement(text, self.gendered, self.nouns),
+                 *rules.direct_before_postposition(text, self.oblique)]
+        for what, message in found:
+            at = text.find(what.split()[0]) if what.split() else -1
+            index = sum(1 for start in starts or [0] if start <= max(at, 0)) - 1
+            yield Problem(file, lines[index], f"{self.language}: {message}")
 
     def _latin_runs(self, ur: str, file: Path, line: int, before: str = "") -> Iterator[Problem]:
         if not _URDU.search(ur):
@@ -230,6 +255,10 @@ class Glossary:
             if text:
                 english = ids[min(i, len(ids) - 1)]
                 problems += self.problems(text, (po, line), english, keep)
+        for english in ids:
+            problems += [Problem(po, message.lineno, _("the English: {message}").format(
+                message=found)) for _code, found in rules.code_outside_spans(
+                    english, translated=False)]
         return problems
 
     def check_readme(self, path: Path) -> list[Problem]:
@@ -248,16 +277,41 @@ class Glossary:
                     open=RTL_OPEN)))
         fenced = False
         previous = ""
+        paragraph: list[tuple[int, str]] = []
+
+        def sentences() -> list[Problem]:
+            """The grammar of the paragraph read so far, its lines joined."""
+            joined, starts = "", []
+            for _n, line_text in paragraph:
+                starts.append(len(joined))
+                joined += line_text.strip() + " "
+            found = list(self.grammar(joined, path, [n for n, _t in paragraph], starts))
+            paragraph.clear()
+            return found
+
         for n, text in enumerate(lines, 1):
             if HTML_WRAPPER.match(text):
                 continue
             if text.lstrip().startswith("```"):
                 fenced = not fenced
                 previous = ""
+                problems += sentences()
                 continue
             if not fenced:
                 continues = previous and not re.match(r"\s*(?:[-*|#]|\d+\.)\s", text + " ")
-                problems += self.problems(text, (path, n), before=previous if continues else "")
+                if not continues or not text.strip():
+                    problems += sentences()
+                if text.strip():
+                    paragraph.append((n, text.strip().strip("|").replace("|", "،")))
+                start = rules.block_starts_latin(text) if not continues and text.strip() \
+                    else None
+                if start is not None:
+                    problems.append(Problem(path, n, _(
+                        "{lang}: this block starts with a Latin word ({start!r}), so GitHub "
+                        "lays it out left to right: start it with an Urdu word").format(
+                        lang=self.language, start=start)))
+                problems += self.problems(text, (path, n), before=previous if continues else "",
+                                          grammar=False)
                 previous = text if text.strip() and not text.lstrip().startswith(("|", "#")) \
                     else ""
                 continue
@@ -269,6 +323,8 @@ class Glossary:
                     "{lang}: a comment in a code block is not translated: {comment!r}").format(
                     lang=self.language, comment=comment)))
             problems += self.problems(comment, (path, n))
+        problems += sentences()
+        problems.sort(key=lambda p: p.line or 0)
         return problems
 
 

@@ -234,8 +234,8 @@ def _success_hint(scan: Any, nearest: float | None, said: bool) -> str:
                  "Check your threshold.").format(nearest=nearest)
     return _("Use only readings that are finite and within `[range_min, range_max]`, at "
              "angles within +-30 degrees of straight ahead (wrap "
-             "`angle_min + i * angle_increment` into `[-pi, pi]`); success means all of them are at least "
-             "0.5 m.")
+             "`angle_min + i * angle_increment` into `[-pi, pi]`); success means all of them "
+             "are at least 0.5 m.")
 
 
 def rate_reports(rates: Any, start: float, end: float) -> list[float]:

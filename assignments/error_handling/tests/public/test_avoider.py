@@ -93,7 +93,8 @@ def test_drives_when_clear(avoider, feeder, probe, commands):
     if wrong:
         raise StudentFailure(
             _("With a clear way ahead cmd_vel said {got}; expected "
-              "`linear.x={v}, angular.z=0` on every cycle.").format(got=describe(wrong[0]), v=FORWARD),
+              "`linear.x={v}, angular.z=0` on every cycle.").format(
+                got=describe(wrong[0]), v=FORWARD),
             _("Nothing was nearer than 2 m: with no valid reading within ±30° of ahead at "
               "0.6 m or nearer, publish `linear.x=0.2, angular.z=0` on every cycle."))
 
@@ -177,7 +178,8 @@ def test_rejects_malformed_scans(avoider, feeder, probe, commands):
                                    _("nothing")),
                 hint if going else
                 _("Before using a scan, check `len(ranges)` against "
-                  "`(angle_max - angle_min) / angle_increment + 1`; reject an empty or mismatched scan with a stop."))
+                  "`(angle_max - angle_min) / angle_increment + 1`; reject an empty or mismatched "
+                  "scan with a stop."))
     settle_forward(probe, commands, feeder, avoider)
 
 
