@@ -115,6 +115,7 @@ class SimBridge:
         self._clock_log: list[tuple[int, float]] = []
         self._threads: list[threading.Thread] = []
         self._taps: list[Callable[[str, str, Any, float], None]] = []
+        self._listened: dict[str, object] = {}  # topic -> its subscription (see listen)
         # Pace changes due at a sim time (schedule_real_time_factor), soonest first, and
         # those made so far as (sim time, rtf).
         self._pace_due: list[tuple[float, float]] = []
@@ -152,6 +153,7 @@ class SimBridge:
         for thread in self._threads:
             thread.join()
         self._threads = []
+        self._take_last_commands()
         self._receiving.close()
         self._executor.remove_node(self.node)
         self._executor.shutdown(timeout_sec=1.0)
@@ -229,6 +231,15 @@ class SimBridge:
         """Hand every message published or received to ``tap(topic, type name, message,
         sim time)`` (add taps before :meth:`start`; a tap must not raise)."""
         self._taps.append(tap)
+
+    def listen(self, topic: str, msg_type: type) -> None:
+        """Also hand taps what goes out on ``topic``, a topic the world does not use (a
+        command for another node, to record a hand run), at the sim time it arrives.
+        Once per topic; the executor's thread takes the messages."""
+        if topic in self._listened or topic == CMD_VEL_TOPIC:
+            return
+        self._listened[topic] = self.node.create_subscription(
+            msg_type, topic, lambda msg: self._tap(topic, msg, self.world.time), 10)
 
     def _tap(self, topic: str, message: Any, t: float) -> None:
         for tap in self._taps:
@@ -350,6 +361,20 @@ class SimBridge:
                 self._on_cmd_vel(taken[0])
                 count += 1
         return count
+
+    def _take_last_commands(self) -> None:
+        """The commands that came after the last tick (a node's stop as its run ends): no
+        tick will drive them, but the recording and the taps (a bag) end with them, at
+        the sim time the world stopped."""
+        sub = self._cmd_sub
+        with self._cond, contextlib.suppress(RuntimeError), sub.handle:
+            # RuntimeError: rclpy's RCLError or InvalidHandle, the context already shut
+            # down (Ctrl-C in a hand run): nothing more can be taken, nothing is lost.
+            while (taken := sub.handle.take_message(sub.msg_type, sub.raw)) is not None:
+                twist = twist_of(taken[0])
+                self.sim.recording.add_command(self.world.time, twist.linear.x,
+                                               twist.angular.z)
+                self._tap("/cmd_vel", taken[0], self.world.time)
 
     def _note_lateness(self, info: object) -> None:
         """Count a command sent before the tick now due: ticks went on without it.  When it

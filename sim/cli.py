@@ -169,6 +169,8 @@ def run_world(spec, *, rtf: float, duration: float | None, domain: int,  # noqa:
                     or (companion is not None and not companion.running()))
 
         while not over():
+            if recorder is not None:
+                _record_drivers(bridge)
             bridge.wait_for(over, sim_timeout=math.inf, wall_timeout=0.5)
             _warn_mismatches(bridge, warned)
     except KeyboardInterrupt:
@@ -318,6 +320,20 @@ def _recorder(folder: Path, bridge, world: str):  # noqa: ANN001, ANN202 - SimBr
         return None
     bridge.add_tap(recorder)
     return recorder
+
+
+def _record_drivers(bridge) -> None:  # noqa: ANN001 - SimBridge
+    """A recorded hand run also records the velocity commands sent to other nodes: what
+    ``sim drive --topic /agent/cmd_vel`` gives the student's node, beside the /cmd_vel
+    that node sends on (every Twist or TwistStamped topic on the graph, found as it
+    appears)."""
+    from sim.cmdvel import MESSAGE_TYPES, full_name
+
+    types = {full_name(kind): message for kind, message in MESSAGE_TYPES.items()}
+    for topic, names in bridge.node.get_topic_names_and_types():
+        found = next((types[name] for name in names if name in types), None)
+        if found is not None:
+            bridge.listen(topic, found)
 
 
 def _warn_mismatches(bridge, warned: set[object]) -> None:  # noqa: ANN001

@@ -224,3 +224,41 @@ def test_type_names_and_full_text_follow_rosbag2() -> None:
     assert rest.startswith("MSG: geometry_msgs/Vector3\n")
     with pytest.raises(msgdefs.DefinitionNotFound):
         msgdefs.full_text("no_such_pkg/msg/Nothing")
+
+
+def test_a_command_after_the_last_tick_still_ends_the_recording(
+        ros_domain: int, tmp_path: Path) -> None:
+    """A node's stop sent as its run ends comes after the world's last tick: the bag and
+    the replay's commands end with it, not with the command before (issue 31)."""
+    from rclpy.duration import Duration
+
+    context = Context()
+    rclpy.init(context=context, domain_id=ros_domain)
+    bridge = SimBridge(World(load_world("empty_room")), context, max_clock_hz=50.0)
+    recorder = BagRecorder(tmp_path / "run", mount=(0.0, 0.0, 0.0))
+    bridge.add_tap(recorder)
+    sender = Node("sender", context=context)
+    publisher = sender.create_publisher(Twist, "/cmd_vel", 10)
+    bridge.pause()
+    bridge.start()
+    try:
+        assert bridge.wait_for(lambda: publisher.get_subscription_count() > 0, 1.0, WALL)
+        go = Twist()
+        go.linear.x = 0.5
+        publisher.publish(go)
+        assert bridge.wait_for(lambda: bridge.take_commands() > 0, 1.0, WALL)
+        bridge.step(STEPS)
+        publisher.publish(Twist())  # the stop, after the last tick
+        # Reliable: acknowledged means it is in the world's reader, untaken by any tick.
+        assert publisher.wait_for_all_acked(Duration(seconds=WALL))
+        stopped_at = bridge.now
+    finally:
+        bridge.stop()
+        sender.destroy_node()
+        rclpy.try_shutdown(context=context)
+    assert recorder.close() == tmp_path / "run"
+    _summary, messages, _metadata = _read(tmp_path / "run")
+    commands = [(m.log_time, d.linear.x) for topic, m, d in messages if topic == "/cmd_vel"]
+    assert commands[-1] == (round(stopped_at * 1e9), 0.0) and len(commands) == 2
+    last = bridge.recording.commands[-1]
+    assert (last.t, last.linear) == (stopped_at, 0.0)

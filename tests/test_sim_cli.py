@@ -57,3 +57,40 @@ def test_run_records_a_bag(tmp_path: Path, ros_domain: int) -> None:
               for t in info["topics_with_message_count"]}
     assert counts["/odom"] == counts["/tf"] >= 50 and counts["/scan"] >= 10  # 1 s or more
     assert counts["/tf_static"] == 1 and (bag / "bag_0.mcap").is_file()
+
+
+def test_a_recorded_hand_run_keeps_the_commands_sent_to_the_students_node(
+        tmp_path: Path, ros_domain: int) -> None:
+    """`sim drive --topic /agent/cmd_vel` drives the student's node, not the robot: the
+    bag has those commands too, beside the world's topics (issue 31)."""
+    import threading
+
+    import rclpy
+    from geometry_msgs.msg import Twist
+    from rclpy.context import Context
+    from rclpy.node import Node
+
+    from sim.cli import run_world
+    from sim.worldfile import load_world
+
+    bag = tmp_path / "bag"
+    run = threading.Thread(target=run_world, args=(load_world("empty_room"),), kwargs={
+        "rtf": 1.0, "duration": 3.0, "domain": ros_domain, "bag": bag})
+    context = Context()
+    rclpy.init(context=context, domain_id=ros_domain)
+    driver = Node("driver", context=context)
+    publisher = driver.create_publisher(Twist, "/agent/cmd_vel", 10)
+    wish = Twist()
+    wish.linear.x = 3.0
+    run.start()
+    try:
+        while run.is_alive():  # as `sim drive` does: a command every 50 ms
+            publisher.publish(wish)
+            run.join(timeout=0.05)
+    finally:
+        driver.destroy_node()
+        rclpy.try_shutdown(context=context)
+    info = yaml.safe_load((bag / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
+    topics = {t["topic_metadata"]["name"]: t for t in info["topics_with_message_count"]}
+    assert topics["/agent/cmd_vel"]["message_count"] > 10
+    assert topics["/agent/cmd_vel"]["topic_metadata"]["type"] == "geometry_msgs/msg/Twist"
