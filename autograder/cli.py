@@ -235,8 +235,8 @@ def _run(exercise: str, submission: Path, hidden: bool, outputs: dict[str, Path 
     # failures and the score (and the lines of tests that never ended).
     live = LiveLines(lambda text: click.echo(text, nl=False), color, in_place)
 
-    def running(raw: RawTest | None) -> None:
-        live.running(raw.nodeid if raw else None, raw.label if raw else "")
+    def running(now: list[RawTest]) -> None:
+        live.running_now([(raw.nodeid, raw.label) for raw in now])
 
     notice = rtl_notice(html=outputs.get("html"))
     if notice:

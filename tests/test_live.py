@@ -92,3 +92,30 @@ def test_color_and_redrawing_only_on_a_terminal_that_allows_them(
     for key, value in env.items():
         monkeypatch.setenv(key, value)
     assert terminal_style(Stream(tty)) == style
+
+
+def test_modules_at_once_are_all_on_the_line_so_the_one_that_ends_was_named():
+    """Two test modules run at once: the line names both tests, each with its own time,
+    and whichever ends next (here the second) was on it (issue 31)."""
+    out: list[str] = []
+    clock = Clock()
+    live = LiveLines(out.append, in_place=True, clock=clock, width=lambda: 80)
+    live.running_now([("a.py::test_a", "The node starts")])
+    clock.now += 2.0
+    live.running_now([("a.py::test_a", "The node starts"), ("b.py::test_b", "It turns")])
+    assert out[-1] == CLEAR + " …   2 s  The node starts  ·    0 s  It turns"
+    live.done(TestResult("test_b", "It turns", Fraction(1), Fraction(1), "passed",
+                         data={"nodeid": "b.py::test_b"}))
+    clock.now += 1.0
+    live.running_now([("a.py::test_a", "The node starts")])  # its time kept, not restarted
+    assert out[-2:] == [" ✔   1/1  It turns\n", CLEAR + " …   3 s  The node starts"]
+
+
+def test_several_running_tests_share_the_width():
+    out: list[str] = []
+    live = LiveLines(out.append, in_place=True, clock=Clock(), width=lambda: 40)
+    live.running_now([("a.py::a", "A label much longer than its share"),
+                      ("b.py::b", "Another long label here")])
+    line = out[-1][len(CLEAR):]
+    assert len(line) <= 39 and line.count("…") == 3  # the mark, and both labels cut
+    assert "A label" in line and "Another" in line

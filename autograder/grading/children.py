@@ -36,7 +36,7 @@ class Watchers:
     """Who is told how the run goes (see :func:`autograder.grading.run.grade`)."""
 
     progress: Progress | None = None
-    running: Callable[[RawTest | None], None] | None = None
+    running: Callable[[list[RawTest]], None] | None = None  # the tests running now
 
 
 @dataclasses.dataclass
@@ -180,7 +180,7 @@ def wait(children: Sequence[Child], limit: float, watchers: Watchers,
         if watchers.progress is not None or watchers.running is not None:
             now = _tell(children, reported, watchers)
             if watchers.running is not None:
-                watchers.running(None if finished else now)
+                watchers.running([] if finished else now)
         if finished:
             return
         if time.monotonic() > deadline:
@@ -201,10 +201,11 @@ def _stopped(pid: int) -> bool:
         return False
 
 
-def _tell(children: Sequence[Child], reported: set[str], watchers: Watchers) -> RawTest | None:
-    """Tell ``progress`` each test that finished since last time; the test that runs now
-    in some running child (each runs its tests in collection order: the first not done)."""
-    running = None
+def _tell(children: Sequence[Child], reported: set[str], watchers: Watchers) -> list[RawTest]:
+    """Tell ``progress`` each test that finished since last time; the tests that run now,
+    one per running child (each runs its tests in collection order: the first not done),
+    so that whichever ends next was among them."""
+    running = []
     for child in children:
         tests = child.reported_tests()
         for test in tests:
@@ -212,8 +213,9 @@ def _tell(children: Sequence[Child], reported: set[str], watchers: Watchers) -> 
                 reported.add(test.nodeid)
                 if watchers.progress is not None:
                     watchers.progress(test)
-        if running is None and child.process.returncode is None:
-            running = next((t for t in tests if not t.done), None)
+        now = next((t for t in tests if not t.done), None)
+        if now is not None and child.process.returncode is None:
+            running.append(now)
     return running
 
 

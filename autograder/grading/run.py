@@ -51,14 +51,14 @@ REGRADES = 2
 def grade(exercise: Exercise, submission: Path | None, *, hidden: bool = True,
           domain: int | None = None, real_time_factor: float | None = None,
           progress: Progress | None = None,
-          running: Callable[[RawTest | None], None] | None = None,
+          running: Callable[[list[RawTest]], None] | None = None,
           record: Path | None = None, module_jobs: ModuleJobs = "auto") -> RunResult:
     """Run the exercise's public (and, with ``hidden``, hidden) tests on ``submission``.
 
     ``submission`` is the student's file or a folder holding it; None grades the reference
     solution.  Always returns a result: a broken submission scores what it showed, a fault
     of ours sets ``grader_error``.  ``progress`` gets each test as it finishes;
-    ``running``, a few times a second, a test that runs now (None between tests).
+    ``running``, a few times a second, the tests that run now (one per child).
     With ``record``, each test module's graph is recorded as a rosbag2 bag in that folder
     (``data["bags"]``); a recording that fails is only a warning (``data["warnings"]``).
     ``module_jobs`` children run the test modules at once, each on a domain of its own
@@ -93,7 +93,7 @@ def _wait_until_gone(uids: Sequence[int], seconds: float) -> None:
 def _grade_once(exercise: Exercise, submission: Path | None, *, hidden: bool,
                 domain: int | None, real_time_factor: float | None,
                 progress: Progress | None,
-                running: Callable[[RawTest | None], None] | None,
+                running: Callable[[list[RawTest]], None] | None,
                 record: Path | None, module_jobs: ModuleJobs) -> RunResult:
     """One grading of ``submission`` (see :func:`grade`)."""
     started = time.monotonic()

@@ -12,7 +12,7 @@ from __future__ import annotations
 import os
 import shutil
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import TextIO
 
 from autograder.core.results import TestResult
@@ -45,27 +45,36 @@ class LiveLines:
         self._clock = clock
         self._width = width
         self.shown: set[str] = set()  # line_key of every line printed
-        self._running: tuple[str, float] | None = None  # the running test, since when
+        self._since: dict[str, float] = {}  # each running test, since when
         self._drawn = ""  # what the running line shows now ("" if none)
 
     def running(self, nodeid: str | None, label: str = "") -> None:
         """The test that runs now (None: none); redrawn in place when its text changes."""
+        self.running_now([(nodeid, label)] if nodeid is not None else [])
+
+    def running_now(self, tests: Sequence[tuple[str, str]]) -> None:
+        """The tests that run now, as ``(node id, label)``, one per test module running at
+        once: all are named, so the one that ends next is always on the line (each gets
+        an equal share of the width)."""
         if not self.in_place:
             return
-        if nodeid is None:
+        now = self._clock()
+        self._since = {nodeid: self._since.get(nodeid, now) for nodeid, _label in tests}
+        if not tests:
             self._draw("")
-            self._running = None
             return
-        if self._running is None or self._running[0] != nodeid:
-            self._running = (nodeid, self._clock())
-        seconds = int(self._clock() - self._running[1])
-        took = _("{seconds} s").format(seconds=seconds)
-        self._draw(for_terminal(f" … {took:>5}  {label}"))
+        width = max(self._width() - 1, 10)
+        share = max((width - 2) // len(tests) - 3, 12)
+        parts = [f"{_took(now - self._since[nodeid]):>5}  {label}" for nodeid, label in tests]
+        if len(parts) == 1:
+            self._draw(for_terminal(f" … {parts[0]}"))
+        else:
+            self._draw(" … " + "  ·  ".join(_clip(for_terminal(part), share) for part in parts))
 
     def done(self, test: TestResult) -> None:
         """A test ended: its line, for good (replacing the running line)."""
         self._draw("")
-        self._running = None
+        self._since.pop(line_key(test), None)
         self._write(test_line(test, self.color) + "\n")
         self.shown.add(line_key(test))
 
@@ -81,3 +90,11 @@ class LiveLines:
         if text != self._drawn:
             self._write(_CLEAR + text)
             self._drawn = text
+
+
+def _clip(text: str, width: int) -> str:
+    return text if len(text) <= width else text[:width - 1] + "…"
+
+
+def _took(seconds: float) -> str:
+    return _("{seconds} s").format(seconds=int(seconds))
