@@ -82,3 +82,25 @@ def test_bad_form_is_a_400_naming_the_problem(server: QuizServer) -> None:
     with pytest.raises(urllib.error.HTTPError) as info:
         _get(server.url + "quiz/nope/")
     assert info.value.code == 404
+
+
+URDU_ANSWER = 'آپ کا جواب: <bdi><bdi dir="ltr">8</bdi> بار</bdi>'
+
+
+@pytest.mark.parametrize(("lang", "said"), [("en", "Your answer: <bdi>8 calls</bdi>"),
+                                            ("ur", URDU_ANSWER)])
+def test_the_result_page_shows_the_students_own_answer(server: QuizServer, lang: str,
+                                                       said: str) -> None:
+    """As the terminal does: the options chosen, the number given; nothing for a question
+    left unanswered (issue 31)."""
+    fields = [("lang", lang), ("q:calls-in-two-seconds", "۸"),
+              ("q:keep-in-step", "same-group"), ("q:keep-in-step", "lock")]
+    status, page = _post(server.url + "quiz/timer-synchronization/submit", fields)
+    assert status == 200
+
+    def section(question: str) -> str:
+        return page.split(f'id="feedback-{question}"')[1].split("</section>")[0]
+
+    assert f'<p class="answer">{said}</p>' in section("calls-in-two-seconds")
+    assert section("keep-in-step").count("<code") == 2  # both options, their code as code
+    assert 'class="answer"' not in section("period-units")

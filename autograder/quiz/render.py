@@ -99,14 +99,21 @@ def render_result(quiz: Quiz, result: RunResult, answers: Mapping[str, Any],
             answers_json=json.dumps(saved, ensure_ascii=False, indent=2))
 
 
-def _feedback(quiz: Quiz, result: RunResult) -> list[tuple[Any, Text, Text | None]]:
+def _feedback(quiz: Quiz, result: RunResult
+              ) -> list[tuple[Any, Text, Text | None, Text | None]]:
+    """Per question: its result, its text, its explanation and the student's own answer
+    as they read it back (the options they chose, the number they gave), as the terminal
+    shows it; None where they gave none."""
     loc = Localizer(quiz, result.lang)
     rows = []
     for t in result.tests:
         q = quiz.question(t.name)
         assert q is not None, t.name
+        given = t.data.get("answer")
+        answer = None if given is None else Text(
+            question_type(q.type).answer_text(quiz, q, given, loc), result.lang)
         rows.append((t, loc.text(q, "text"),
-                     loc.text(q, "explanation") if q.explanation else None))
+                     loc.text(q, "explanation") if q.explanation else None, answer))
     return rows
 
 
