@@ -38,11 +38,22 @@ def test_crash_at_start_scores_zero_with_its_traceback(graded):
 
 def test_wrong_node_name_is_reported_with_the_names_seen(graded):
     result = graded["wrong_node_name"]
-    # Only the invalid-override test, which needs no node name, can pass.
-    assert failed_tests(result) >= {t.name for t in result.tests} - {
-        "test_invalid_override_exits"}
+    # Every test loses, the invalid-override one too: it first waits for the node named
+    # velocity_governor, started with a valid override.
+    assert failed_tests(result) == {t.name for t in result.tests}
     assert "No node named 'velocity_governor'" in result.tests[0].message
     assert "governor" in result.tests[0].message
+
+
+def test_a_crash_that_names_the_parameters_earns_nothing(graded):
+    """A program that crashes at import exits non-zero, and its traceback names both speed
+    limits: the invalid-override test still gives it nothing, as it never read them."""
+    result = graded["crashes_naming_parameters"]
+    assert result.grader_error is None, explain(**diagnosis(result))
+    assert result.score == 0
+    test = {t.name: t for t in result.tests}["test_invalid_override_exits"]
+    assert "max_linear_speed" in test.message and "max_angular_speed" in test.message
+    assert "did not come up" in test.message
 
 
 def test_node_that_never_spins_fails_what_needs_spinning(graded):

@@ -8,11 +8,14 @@ from autograder.i18n import _
 
 # Startup is a matter of the process, not of simulation time: wall seconds.
 EXIT_WITHIN = 10.0
+NODE = "velocity_governor"
+VALID = ("max_linear_speed", 0.8)  # within its range: the node must run with it
 
 
 @pytest.mark.points(1)
-def test_invalid_override_exits(start_node):
-    """Started with an invalid override, the node exits non-zero naming the parameter"""
+def test_invalid_override_exits(start_node, probe):
+    """Started with an invalid override, the node exits non-zero and its log names the parameter"""
+    _reads_a_valid_override(start_node, probe)
     # Overrides the node did refuse, naming them: proof that its startup check exists.
     refused_before: list[tuple[str, float]] = []
     for name, value in (("max_linear_speed", 3.0), ("max_angular_speed", -1.0)):
@@ -36,6 +39,31 @@ def test_invalid_override_exits(start_node):
                     name=name, value=value, tail=node.output_tail(8)),
                 _("Log the problem with `self.get_logger().error(...)`, naming the parameter."))
         refused_before.append((name, value))
+
+
+def _reads_a_valid_override(start_node, probe) -> None:
+    """The same program, started with a valid override, comes up and holds that value: its
+    exits below are then refusals of a value it read, not a crash that happens to print a
+    parameter's name."""
+    name, value = VALID
+    try:
+        node = start_node({name: value})
+    except StudentFailure as failure:
+        raise StudentFailure(
+            _("Started with a valid override, -p {name}:={value}, the node did not come up, "
+              "so an exit with an invalid one would show nothing:\n{why}").format(
+                name=name, value=value, why=failure.message), failure.hint) from None
+    try:
+        held = probe.get_parameters(NODE, [name])[name]
+    finally:
+        node.stop()
+    if held != value:
+        raise StudentFailure(
+            _("Started with -p {name}:={value}, the node came up but reads {name}={held!r}, "
+              "so an exit with an invalid value would not be a refusal of it.").format(
+                name=name, value=value, held=held),
+            _("Declare {name} with `self.declare_parameter('{name}', 0.5)`: the -p override "
+              "then becomes its value.").format(name=name))
 
 
 def _still_running_hint(name: str, value: float,
