@@ -26,6 +26,7 @@ from sensor_msgs.msg import LaserScan
 from std_msgs.msg import String
 
 ARRIVED = 0.15          # m: stop this close to the goal (the task allows 0.3)
+STOPPED = 0.02          # m/s: slower than this, the robot has stopped (report only then)
 CLEARANCE = 0.25        # m: robot radius (0.105) plus a margin, each side of a path
 LOOKAHEAD = 1.0         # m: a heading is fully open if this much of it is clear
 SAFE = 0.35             # m: never head where less than this is clear
@@ -88,6 +89,7 @@ class AiAgentBridge(Node):
         self.agent = NavigationAgent()
         self.pose = None
         self.points = None
+        self.speed = 0.0
         self.reported = False
         self.cmd_vel = self.create_publisher(Twist, 'cmd_vel', 10)
         self.status = self.create_publisher(String, 'agent_status', 10)
@@ -98,6 +100,7 @@ class AiAgentBridge(Node):
     def on_odom(self, msg):
         p, q = msg.pose.pose.position, msg.pose.pose.orientation
         self.pose = (p.x, p.y, 2.0 * math.atan2(q.z, q.w))  # yaw of a planar quaternion
+        self.speed = abs(msg.twist.twist.linear.x)  # the wheels' speed, m/s
 
     def on_scan(self, scan):
         # Obstacle points in the robot frame; NaN and inf (no return) are dropped.
@@ -114,7 +117,9 @@ class AiAgentBridge(Node):
         command = Twist()
         command.linear.x, command.angular.z = v, w
         self.cmd_vel.publish(command)
-        if arrived and not self.reported:
+        # Arrived is not stopped: the robot brakes for a moment after the zero Twist, so
+        # report once the odometry says it stands, and only once.
+        if arrived and self.speed < STOPPED and not self.reported:
             self.reported = True
             self.status.publish(String(data='goal reached'))
             self.get_logger().info(f'goal reached at ({self.pose[0]:.2f}, {self.pose[1]:.2f})')

@@ -82,7 +82,9 @@ class AiAgentBridge(Node):
         command = Twist()
         command.linear.x, command.angular.z = v, w
         self.cmd_vel.publish(command)
-        # TODO: when `arrived` first becomes true, publish 'goal reached' on agent_status.
+        # TODO: once `arrived` and the robot has stopped (the odometry's
+        # twist.twist.linear.x below 0.02 m/s), publish 'goal reached' on agent_status,
+        # once.
 
 
 def main(args=None):

@@ -77,8 +77,14 @@ class Mission:
         points = [(s.x, s.y) for s in self.samples if s.t <= end]
         return sum(math.dist(a, b) for a, b in zip(points, points[1:], strict=False))
 
-    def pose_at(self, t: float) -> Any | None:
-        return min(self.samples, key=lambda s: abs(s.t - t), default=None)
+    def state_at(self, t: float) -> Any | None:
+        """The robot's last recorded state at or before ``t`` (what was true when a
+        message was sent, not a moment later)."""
+        return max((s for s in self.samples if s.t <= t), key=lambda s: s.t, default=None)
+
+    def stopped_at_goal(self, sample: Any) -> bool:
+        """Within REACHED of the goal and slower than STILL: arrived, as the task says."""
+        return self.to_goal(sample) <= REACHED and abs(sample.v) < STILL
 
 
 def fly(world: Any, probe: Any, student: Any, limit: float) -> Mission:

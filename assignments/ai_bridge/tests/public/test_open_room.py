@@ -1,7 +1,14 @@
 """Public tests: in an open room, the agent turns, drives to its goal, stops and says so."""
 
 import pytest
-from helpers import REACHED, STATUS_WITHIN, goal_parameters, judge_efficiency, judge_reached
+from helpers import (
+    REACHED,
+    STATUS_WITHIN,
+    STILL,
+    goal_parameters,
+    judge_efficiency,
+    judge_reached,
+)
 
 from autograder.core.errors import StudentFailure
 from autograder.i18n import _
@@ -20,7 +27,7 @@ def test_open_room_reaches_goal(mission, credit):
 
 @pytest.mark.points(2)
 def test_open_room_reports_arrival(mission):
-    """On arrival the agent publishes on agent_status, and not before"""
+    """Once stopped within 0.3 m of the goal, the agent publishes on agent_status, not before"""
     if mission.arrived_at is None:
         raise StudentFailure(
             _("The robot never stopped at the goal, so its report could not be judged."),
@@ -33,13 +40,25 @@ def test_open_room_reports_arrival(mission):
             _("Publish a std_msgs/String such as 'goal reached' on agent_status once, when "
               "you stop at the goal."))
     stamp, text = mission.statuses[0]
-    pose = mission.pose_at(stamp)
-    away = mission.to_goal(pose) if pose else mission.distance
-    if away > REACHED + 0.05:
+    state = mission.state_at(stamp)
+    if state is not None and mission.stopped_at_goal(state):
+        return
+    away = mission.to_goal(state) if state is not None else mission.distance
+    if away > REACHED:
         raise StudentFailure(
             _("agent_status said {text!r} while the robot was still {away:.2f} m from the "
               "goal.").format(text=text, away=away),
             _("Report arrival when you are within 0.3 m of the goal, not before."))
+    later = mission.arrived_at - stamp
+    moving = _("agent_status said {text!r} while the robot, {away:.2f} m from the goal, was "
+               "still moving at {speed:.2f} m/s; it stopped {later:.2f} s later.") if later > 0 \
+        else _("agent_status said {text!r} while the robot, {away:.2f} m from the goal, was "
+               "moving at {speed:.2f} m/s.")
+    raise StudentFailure(
+        moving.format(text=text, away=away, speed=abs(state.v), later=later),
+        _("Report once the robot has stopped within 0.3 m of the goal (slower than {still} "
+          "m/s): a stop you have sent still takes the robot a moment. The odometry's "
+          "twist.twist.linear.x says how fast it goes.").format(still=STILL))
 
 
 @pytest.mark.points(1)

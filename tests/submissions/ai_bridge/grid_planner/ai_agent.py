@@ -109,6 +109,7 @@ class AiAgentBridge(Node):
                      self.declare_parameter('goal_y', 0.0).value)
         self.agent = NavigationAgent()
         self.pose = self.points = None
+        self.moving = True  # the odometry's speed is 0.02 m/s or more
         self.done = False
         self.cmd_vel = self.create_publisher(Twist, 'cmd_vel', 10)
         self.status = self.create_publisher(String, 'agent_status', 10)
@@ -119,6 +120,7 @@ class AiAgentBridge(Node):
     def on_odom(self, msg):
         p, q = msg.pose.pose.position, msg.pose.pose.orientation
         self.pose = (p.x, p.y, math.atan2(2 * q.w * q.z, 1 - 2 * q.z * q.z))
+        self.moving = abs(msg.twist.twist.linear.x) >= 0.02
 
     def on_scan(self, scan):
         r = np.array(scan.ranges, dtype=float)
@@ -133,7 +135,7 @@ class AiAgentBridge(Node):
         twist = Twist()
         twist.linear.x, twist.angular.z = float(v), float(w)
         self.cmd_vel.publish(twist)
-        if done and not self.done:
+        if done and not self.moving and not self.done:  # stopped there, not only stopping
             self.done = True
             self.status.publish(String(data=f'reached ({self.goal[0]}, {self.goal[1]})'))
 
