@@ -123,6 +123,20 @@ def test_a_nodes_tail_is_short_and_says_it_was_cut():
     assert "HEAD" not in tail and utf8(tail) <= TAIL_BYTES + 200
 
 
+def test_a_tail_that_shows_rclpys_shutdown_race_explains_it():
+    """The race every exercise README explains is named where a student reads it; any
+    other traceback gets no such note."""
+    race, other = _Output(4096), _Output(4096)
+    race.feed(b"Traceback (most recent call last):\n  File \"x.py\", line 9, in main\n"
+              b"RuntimeError: Unable to convert call argument '0' to Python object\n")
+    other.feed(b"Traceback (most recent call last):\nRuntimeError: the end\n")
+    tail = StudentNode(FakeProcess(race), "ai_agent", probe=None).output_tail()
+    assert tail.splitlines()[-2].endswith("to Python object")
+    assert "is rclpy's shutdown race" in tail.splitlines()[-1]
+    assert "Shutting down cleanly, every time" in tail
+    assert "shutdown race" not in StudentNode(FakeProcess(other), "x", probe=None).output_tail()
+
+
 @pytest.mark.parametrize(("submitted", "shown"), [
     ("mywork/obstacle_avoider.py", 'File "mywork/obstacle_avoider.py", line 55, in on_scan'),
     ("obstacle_avoider.py", 'File "obstacle_avoider.py", line 55, in on_scan'),

@@ -29,6 +29,21 @@ if TYPE_CHECKING:
 
 # Sim seconds a freshly started node is watched for an immediate exit.
 STARTUP_SETTLE = 1.0
+# The last line of rclpy's shutdown race: a KeyboardInterrupt that landed while rclpy was
+# converting an incoming message (every exercise README explains it).
+SHUTDOWN_RACE = "Unable to convert call argument"
+
+
+def shutdown_race_note(output: str) -> str:
+    """A line saying what rclpy's shutdown race is, if ``output`` shows it; else ""."""
+    if SHUTDOWN_RACE not in output:
+        return ""
+    return _("RuntimeError: Unable to convert call argument '0' to Python object is "
+             "rclpy's shutdown race: the signal that stopped the program landed while rclpy "
+             "was converting an incoming message, where except KeyboardInterrupt cannot "
+             "catch it, so it happens only now and then. The exercise READMEs explain it; "
+             "error_handling's (\"Shutting down cleanly, every time\") shows how to take "
+             "the signals yourself so that it never happens.")
 
 class StudentNode:
     """The student's running program, seen from the graph."""
@@ -68,7 +83,7 @@ class StudentNode:
         tail = message_tail(visible(self.output()), lines, max_bytes)
         output = self.process.output
         note = size_note(output.total, output.budget) if output is not None else ""
-        return "\n".join(part for part in (tail, note) if part)
+        return "\n".join(part for part in (tail, note, shutdown_race_note(tail)) if part)
 
     def wait_exit(self, wall_timeout: float) -> int | None:
         """Wait (wall time: exiting is the process's business) for it to end; its status."""

@@ -16,6 +16,7 @@ from helpers import describe, is_zero, raised
 
 from autograder.core.errors import StudentFailure
 from autograder.i18n import _
+from autograder.plugin.student import SHUTDOWN_RACE
 
 pytestmark = pytest.mark.world("empty_room")
 
@@ -83,6 +84,11 @@ def _trial(probe, start_node, sig: signal.Signals, trial: int) -> None:
 def _exit_hint(output: str) -> str:
     """Name what went wrong when the traceback shows rclpy's own signal handling."""
     error = raised(output)
+    if SHUTDOWN_RACE in output:
+        return _("The traceback ends in rclpy's shutdown race (see its note above): the "
+                 "signal was turned into a KeyboardInterrupt that landed inside rclpy. Let "
+                 "your own handlers only note the signal, and stop in ordinary code. "
+                 "{fix}").format(fix=HINT)
     if error in ("RCLError", "ExternalShutdownException") or \
             (error and "context is invalid" in output):
         return _("The traceback ends in {error}: rclpy's own signal handler shut the context "
