@@ -118,4 +118,4 @@ def test_an_ordinary_users_grading_resists_a_program_that_stops_it(tmp_path):
     assert "STOPPING" in log, output[-3000:]
     assert "MEM OPENED" not in log and "MEM DENIED" in log
     assert done.returncode == 3, output[-3000:]
-    assert "Not an official grade" in output
+    assert "this grade is not official" in output  # the student's sentence
