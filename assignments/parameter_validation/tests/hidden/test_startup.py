@@ -8,6 +8,8 @@ from autograder.i18n import _
 
 # Startup is a matter of the process, not of simulation time: wall seconds.
 EXIT_WITHIN = 10.0
+# Invalid overrides, each past another bound: above one limit's range, below the other's.
+OVERRIDES = (("max_linear_speed", 3.0), ("max_angular_speed", -1.0))
 NODE = "velocity_governor"
 VALID = ("max_linear_speed", 0.8)  # within its range: the node must run with it
 
@@ -18,15 +20,17 @@ def test_invalid_override_exits(start_node, probe):
     _reads_a_valid_override(start_node, probe)
     # Overrides the node did refuse, naming them: proof that its startup check exists.
     refused_before: list[tuple[str, float]] = []
-    for name, value in (("max_linear_speed", 3.0), ("max_angular_speed", -1.0)):
+    for i, (name, value) in enumerate(OVERRIDES):
         node = start_node({name: value}, wait_for_node=False)
         code = node.wait_exit(EXIT_WITHIN)
         if code is None:
             node.stop()
+            # What it refuses after this one tells a missing bound from a missing check.
+            later = [(n, v) for n, v in OVERRIDES[i + 1:] if _refuses(start_node, n, v)]
             raise StudentFailure(
                 _("Started with -p {name}:={value}, the node was still running after "
                   "{seconds:.0f} s.").format(name=name, value=value, seconds=EXIT_WITHIN),
-                _still_running_hint(name, value, refused_before))
+                _still_running_hint(name, value, refused_before + later))
         if code == 0:
             raise StudentFailure(
                 _("Started with -p {name}:={value}, the node exited with status 0; a refusal "
@@ -66,12 +70,21 @@ def _reads_a_valid_override(start_node, probe) -> None:
               "then becomes its value.").format(name=name))
 
 
+def _refuses(start_node, name: str, value: float) -> bool:
+    """Whether the node, started with ``-p name:=value``, exits non-zero naming ``name``."""
+    node = start_node({name: value}, wait_for_node=False)
+    code = node.wait_exit(EXIT_WITHIN)
+    if code is None:
+        node.stop()
+    return code not in (None, 0) and name in node.output()
+
+
 def _still_running_hint(name: str, value: float,
-                        refused_before: list[tuple[str, float]]) -> str:
+                        refused: list[tuple[str, float]]) -> str:
     """The fix for a node that ran on with an invalid override, by what it did refuse."""
-    if refused_before:
+    if refused:
         low, high = RANGES[name]
-        other, other_value = refused_before[0]
+        other, other_value = refused[0]
         if value < low:
             text = _("Started with -p {other}:={other_value} it did exit, so the starting "
                      "values are checked, but `{name}={value}` got through: check the lower "
