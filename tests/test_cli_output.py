@@ -51,13 +51,18 @@ class Run:
 
     def __init__(self, stdout: str, stderr: str, code: int, results: dict[str, Any]) -> None:
         self.stdout, self.stderr, self.code, self.results = stdout, stderr, code, results
-        self.lines = [line.removeprefix(RLM) for line in stdout.splitlines()]
+        # The terminal's bidi marks (a line's RLM, code's isolates) are not text.
+        self.lines = [_unmarked(line).removeprefix(RLM) for line in stdout.splitlines()]
 
     def test_lines(self) -> Counter[str]:
         return Counter(m[1] for m in map(TEST_LINE.match, self.lines) if m)
 
     def count(self, text: str) -> int:
-        return self.stdout.replace(RLM, "").count(text)
+        return _unmarked(self.stdout).replace(RLM, "").count(text)
+
+
+def _unmarked(text: str) -> str:
+    return text.replace("\u2066", "").replace("\u2069", "")
 
 
 def _env() -> dict[str, str]:

@@ -10,25 +10,35 @@ or quiz, a port in use); 3 when the autograder itself failed.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import IO, Any
 
 import click
 
-from autograder.i18n import ngettext
+from autograder.i18n import _, ngettext
 
 
-class ProblemsFound(click.ClickException):
+class _Said(click.ClickException):
+    """A click exception whose "Error:" prefix is in the active language (click's own is
+    English whatever the language)."""
+
+    def show(self, file: IO[Any] | None = None) -> None:
+        click.echo(_("Error: {message}").format(message=self.format_message()),
+                   file=file or click.get_text_stream("stderr"))
+
+
+class ProblemsFound(_Said):
     """A check found problems (each already printed as ``file:line: message``)."""
 
     exit_code = 1
 
 
-class UsageProblem(click.ClickException):
+class UsageProblem(_Said):
     """Bad input from the user: one line naming the file and what is wrong."""
 
     exit_code = 2
 
 
-class GraderFault(click.ClickException):
+class GraderFault(_Said):
     """The autograder failed: not the student's fault."""
 
     exit_code = 3

@@ -33,7 +33,15 @@ _WORD = r"[±∓+\u2212-]?[A-Za-z0-9_][\w./+=±°-]*(?:\(\)[\w./+=±°-]*)*"
 LATIN_RUN = re.compile(rf"{_WORD}(?: {_WORD})*", re.ASCII)
 # A bare number (digits and separators: 0.25, 4/5, 1,000): Urdu text holds those as they
 # are, in its own digits' face.
-BARE_NUMBER = re.compile(r"[\d.,/:]+", re.ASCII)
+BARE_NUMBER = re.compile(r"[\d.,/:%]+", re.ASCII)
+# What is laid out left to right inside right-to-left text is everything between two
+# right-to-left letters (or an Urdu comma or full stop): an expression, a call, a pair, an
+# interval and ``name=value`` keep their operators, brackets and commas inside one run, so
+# "range_min <= r <= range_max" never reads "range_max => r => range_min".
+_RTL_TEXT = "\u0590-\u08ff\ufb1d-\ufdff\ufe70-\ufefc"
+_BETWEEN_RTL = re.compile(rf"[^{_RTL_TEXT}\n]+")
+_PAIRS = {"(": ")", "[": "]", "{": "}"}
+_TRIM = " \t,.;:!?"
 FSI, LRI, PDI = "\u2068", "\u2066", "\u2069"
 
 
@@ -111,16 +119,72 @@ def _is_latin(run: str) -> bool:
     return BARE_NUMBER.fullmatch(run) is None
 
 
+def _unbalanced(text: str, start: int, end: int) -> int | None:
+    """The first bracket in ``text[start:end]`` that the stretch does not close (or that
+    closes nothing), if any."""
+    stack: list[int] = []
+    closers = {c: o for o, c in _PAIRS.items()}
+    for i in range(start, end):
+        char = text[i]
+        if char in _PAIRS:
+            stack.append(i)
+        elif char in closers:
+            if not stack or text[stack[-1]] != closers[char]:
+                return i
+            stack.pop()
+    return stack[0] if stack else None
+
+
+def _trimmed(text: str, start: int, end: int) -> Iterator[tuple[int, int]]:
+    """``text[start:end]`` without spaces, sentence punctuation and unpaired quotes at its
+    ends, cut at a bracket it does not close, without one pair of brackets around all of
+    it (in right-to-left text the pair mirrors around the run by itself)."""
+    while start < end:
+        first, last = text[start], text[end - 1]
+        if first in _TRIM or (first in "'\"" and text.count(first, start, end) % 2):
+            start += 1
+        elif last in _TRIM or (last in "'\"" and text.count(last, start, end) % 2):
+            end -= 1
+        else:
+            break
+    if start >= end:
+        return
+    cut = _unbalanced(text, start, end)
+    if cut is not None:
+        yield from _trimmed(text, start, cut)
+        yield from _trimmed(text, cut + 1, end)
+        return
+    if text[start] in _PAIRS and text[end - 1] == _PAIRS[text[start]] \
+            and _unbalanced(text, start + 1, end - 1) is None:
+        yield from _trimmed(text, start + 1, end - 1)
+        return
+    yield start, end
+
+
+def ltr_runs(text: str) -> Iterator[tuple[int, int]]:
+    """Where ``text`` (right to left) holds left-to-right runs: each stretch between
+    right-to-left letters (:func:`_trimmed`) that holds a letter or a digit."""
+    for match in _BETWEEN_RTL.finditer(text):
+        for start, end in _trimmed(text, *match.span()):
+            if re.search(r"[A-Za-z0-9]", text[start:end]):
+                yield start, end
+
+
 def _latin_runs(text: str, wrap: str, end: str, quote: Callable[[str], str] = str) -> str:
     """``text`` with each Latin run between ``wrap`` and ``end``, every piece passed through
     ``quote`` (an escape applied after the match could break an entity like ``&lt;``)."""
     parts, at = [], 0
-    for m in LATIN_RUN.finditer(text):
-        if _is_latin(m.group(0)):
-            parts += [quote(text[at:m.start()]), wrap, quote(m.group(0)), end]
-            at = m.end()
+    for start, stop in ltr_runs(text):
+        if _is_latin(text[start:stop]):
+            parts += [quote(text[at:start]), wrap, quote(text[start:stop]), end]
+            at = stop
     parts.append(quote(text[at:]))
     return "".join(parts)
+
+
+def isolate_runs(text: str) -> str:
+    """``text`` with each left-to-right run (:func:`ltr_runs`) in Unicode isolates."""
+    return _latin_runs(text, LRI, PDI)
 
 
 def isolate_latin(text: str, lead: bool = False) -> Markup:
@@ -129,16 +193,16 @@ def isolate_latin(text: str, lead: bool = False) -> Markup:
     that begins the text is isolated too, so that what stands before it (a question's
     number, "5.") cannot run into it ("5.50")."""
     parts, at = [], 0
-    for m in LATIN_RUN.finditer(text):
-        run = m.group(0)
+    for start, stop in ltr_runs(text):
+        run = text[start:stop]
         if _is_latin(run):
             tag = Markup('<bdi lang="en" dir="ltr">{}</bdi>')
-        elif lead and m.start() == 0:
+        elif lead and start == 0:
             tag = Markup('<bdi dir="ltr">{}</bdi>')
         else:
             continue
-        parts += [escape(text[at:m.start()]), tag.format(run)]
-        at = m.end()
+        parts += [escape(text[at:start]), tag.format(run)]
+        at = stop
     parts.append(escape(text[at:]))
     return Markup("").join(parts)
 

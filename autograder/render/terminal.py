@@ -20,6 +20,7 @@ from babel.numbers import format_percent
 
 from autograder.core.results import RunResult, TestResult, as_decimal, number
 from autograder.i18n import _, get_language, is_rtl, ngettext
+from autograder.quiz.localize import CODE_SPAN, LRI, PDI, ltr_runs
 from autograder.render.verdict import core_label, core_lines
 
 RLM = "\u200f"
@@ -39,17 +40,44 @@ def _first_strong(line: str) -> str | None:
 
 def for_terminal(text: str, lang: str | None = None) -> str:
     """``text`` for a terminal in ``lang`` (default: the active language).  In a
-    right-to-left language, a line holding right-to-left text whose first strong character
-    is left to right starts with U+200F RIGHT-TO-LEFT MARK; lines wholly in Latin script
-    (a program's output, a path) are left as they are.  Idempotent."""
+    right-to-left language, a line holding right-to-left text has each piece of code (a
+    `code span`, or Latin words joined by operators, brackets or commas) in Unicode
+    isolates, so a terminal that lays out bidi text keeps it in its written order; a line
+    whose first strong character is left to right starts with U+200F RIGHT-TO-LEFT MARK.
+    Lines wholly in Latin script (a program's output, a path) are left as they are.
+    Idempotent."""
     if not is_rtl(lang or get_language()):
         return text
     lines = text.split("\n")
     for i, line in enumerate(lines):
-        if _first_strong(line) == "L" and any(
-                unicodedata.bidirectional(c) in ("R", "AL") for c in line):
-            lines[i] = RLM + line
+        if not any(unicodedata.bidirectional(c) in ("R", "AL") for c in line):
+            continue
+        if LRI not in line:
+            line = _isolate_code(line)
+        lines[i] = RLM + line if _first_strong(line) == "L" else line
     return "\n".join(lines)
+
+
+_CODE_MARKS = re.compile(r"[=<>()\[\]{},*+]| [-/%] ")
+
+
+def _isolate_code(line: str) -> str:
+    """``line`` with its code spans, and its runs of Latin words joined by more than
+    spaces, between LRI and PDI (a single word or words joined by spaces need none)."""
+    out = []
+    for i, piece in enumerate(CODE_SPAN.split(line)):
+        if i % 2:
+            out.append(f"{LRI}`{piece}`{PDI}")
+            continue
+        at = 0
+        for start, end in ltr_runs(piece):
+            run = piece[start:end]
+            if _CODE_MARKS.search(run) and re.match(r"[\w(\[{'\"+-]", run) \
+                    and re.search(r"[A-Za-z_]", run):
+                out += [piece[at:start], LRI, piece[start:end], PDI]
+                at = end
+        out.append(piece[at:])
+    return "".join(out)
 
 
 def rtl_notice(lang: str | None = None, html: Path | None = None,

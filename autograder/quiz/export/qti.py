@@ -35,11 +35,11 @@ from autograder.quiz.export.common import Languages, paragraphs
 from autograder.quiz.export.xml import El, el, to_xml
 from autograder.quiz.localize import (
     CODE_SPAN,
-    LATIN_RUN,
     LRI,
     PDI,
     Localizer,
     Text,
+    isolate_runs,
     plain,
     using_language,
 )
@@ -116,8 +116,7 @@ class QtiWriter:
             if i % 2:
                 out.append(el("code", {}, f"{LRI}{piece}{PDI}" if rtl else piece))
             elif piece:
-                out.append(LATIN_RUN.sub(lambda m: f"{LRI}{m.group(0)}{PDI}", piece)
-                           if rtl else piece)
+                out.append(isolate_runs(piece) if rtl else piece)
         return out
 
     def flow(self, text: Text, cls: str | None = None) -> El:
