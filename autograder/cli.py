@@ -530,6 +530,7 @@ def _batch_item(item: str, record: Path | None = None,  # noqa: ANN202
                 module_jobs: int | str = "auto"):
     """How to grade one student's entry for an exercise or a quiz (``record``: a folder
     for each student's bags, exercises only; ``module_jobs``: see :func:`grade`)."""
+    from autograder.core.names import UnknownName, unknown_item
     from autograder.grading.run import grade
     from autograder.quiz.catalog import find_quiz
     from autograder.quiz.scoring import read_answers, score
@@ -555,6 +556,13 @@ def _batch_item(item: str, record: Path | None = None,  # noqa: ANN202
         raise UsageProblem(_("--record records exercise gradings, not quizzes"))
     try:
         quiz = find_quiz(item).quiz
+    except UnknownName as exc:  # neither: the one meant among both kinds
+        from autograder.core.exercise import list_exercises
+        from autograder.quiz.catalog import load_all
+
+        raise UsageProblem(str(unknown_item(
+            item, [e.id for e in list_exercises()], [q.quiz.id for q in load_all()],
+            exc.path))) from None
     except ContentError as exc:
         raise UsageProblem(str(exc)) from None
 

@@ -59,3 +59,16 @@ def test_in_urdu_too() -> None:
     assert result.exit_code == 2
     assert "parameter_validation" in result.output
     assert any("\u0600" <= c <= "\u06ff" for c in result.output)
+
+
+@pytest.mark.parametrize(("item", "expected"), [
+    ("parameter-validaton", "No exercise or quiz named parameter-validaton. Did you mean the "
+                            "exercise parameter_validation or the quiz parameter-validation?"),
+    ("rclpy_part", "No exercise or quiz named rclpy_part. Did you mean rclpy-part2?"),
+])
+def test_grade_batch_suggests_among_exercises_and_quizzes(tmp_path, item: str,
+                                                          expected: str) -> None:
+    result = CliRunner().invoke(main, ["grade-batch", item, str(tmp_path), "--csv",
+                                       str(tmp_path / "g.csv")])
+    assert result.exit_code == 2
+    assert result.output.strip() == f"Error: {expected}"

@@ -58,3 +58,20 @@ def unknown_quiz(name: str, known: list[str], where: Path) -> UnknownName:
                            .format(name=name, suggestion=meant))
     return UnknownName(where, _("No quiz named {name}; the quizzes are {known}.")
                        .format(name=name, known=", ".join(known) or "-"))
+
+
+def unknown_item(name: str, exercises: list[str], quizzes: list[str],
+                 where: Path) -> UnknownName:
+    """"No exercise or quiz named X" (``grade-batch`` takes either), with the one meant."""
+    meant = suggest(name, [*exercises, *quizzes])
+    both = [suggest(meant, exercises), suggest(meant, quizzes)] if meant else []
+    if len(both) == 2 and all(b is not None and _plain(b) == _plain(meant) for b in both):
+        return UnknownName(where, _("No exercise or quiz named {name}. Did you mean the "
+                                    "exercise {exercise} or the quiz {quiz}?").format(
+            name=name, exercise=both[0], quiz=both[1]))
+    if meant is not None:
+        return UnknownName(where, _("No exercise or quiz named {name}. Did you mean "
+                                    "{suggestion}?").format(name=name, suggestion=meant))
+    return UnknownName(where, _("No exercise or quiz named {name}; the exercises are "
+                                "{exercises}, the quizzes {quizzes}.").format(
+        name=name, exercises=", ".join(exercises) or "-", quizzes=", ".join(quizzes) or "-"))
