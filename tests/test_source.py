@@ -7,6 +7,7 @@ from __future__ import annotations
 import csv
 import importlib.util
 import json
+import os
 import subprocess
 import sys
 import time
@@ -122,21 +123,26 @@ def test_sim_run_refuses_the_same_files_before_its_world(tmp_path: Path, name: s
     assert "World" not in result.output
 
 
+@pytest.mark.parametrize("lang", ["en", "ur"])
 @pytest.mark.parametrize("name", list(BAD))
-def test_a_refusal_is_said_at_once_by_a_fresh_process(tmp_path: Path, name: str,
+def test_a_refusal_is_said_at_once_by_a_fresh_process(tmp_path: Path, name: str, lang: str,
                                                       record_property) -> None:
-    """The whole command, interpreter start included, as a student runs it; the time is
-    measured and recorded (see the report's properties), not asserted."""
+    """The whole command, interpreter start included, as a student runs it, the language
+    from AUTOGRADER_LANG; the time is measured and recorded (the report's properties), not
+    asserted."""
     given = _given(tmp_path, name)
     started = time.monotonic()
     proc = subprocess.run([sys.executable, "-m", "autograder", "check", EXERCISE, str(given)],
-                          capture_output=True, text=True, timeout=60)
+                          capture_output=True, text=True, timeout=60,
+                          env={**os.environ, "AUTOGRADER_LANG": lang})
     seconds = time.monotonic() - started
     record_property("seconds", round(seconds, 3))
-    print(f"{name}: refused in {seconds:.2f} s")
+    print(f"{name} ({lang}): refused in {seconds:.2f} s")
     assert proc.returncode == 2, proc.stderr
     assert proc.stdout == ""
-    assert len(_sentences(proc.stderr)) == 1, proc.stderr
+    [sentence] = _sentences(proc.stderr)
+    assert str(given) in sentence
+    assert any(ord(c) in URDU for c in sentence) == (lang == "ur"), sentence
 
 
 def test_a_syntax_error_reads_as_python_prints_it(tmp_path: Path) -> None:
