@@ -142,3 +142,52 @@ def test_start_copies_the_world_the_readme_names(tmp_path: Path):
         assert {found.file, "README.md", "README.ur.md"} == {
             n for n in copied if not n.endswith(".yaml")}
         assert len(copied) == 3 + any(w.startswith("mydir/") for w in graded_worlds(found))
+
+
+def _graded_tests(exercise: Exercise) -> list[tuple[str, str, int, str]]:
+    """(name, label, points, visibility) of each test, read from the test files."""
+    import ast
+
+    found = []
+    for path in sorted((exercise.folder / "tests").glob("*/test_*.py")):
+        for node in ast.parse(path.read_text(encoding="utf-8")).body:
+            if isinstance(node, ast.FunctionDef) and node.name.startswith("test"):
+                points = next(d.args[0].value for d in node.decorator_list
+                              if isinstance(d, ast.Call)
+                              and getattr(d.func, "attr", "") == "points")
+                label = (ast.get_docstring(node) or "").splitlines()[0].strip()
+                found.append((node.name, label, points, path.parent.name))
+    return found
+
+
+def _grading_table(text: str) -> list[list[str]]:
+    """The cells of each row of the README's grading table (the one headed "| test |")."""
+    lines = text.splitlines()
+    start = next(i for i, line in enumerate(lines) if line.startswith("| test |"))
+    rows = []
+    for line in lines[start + 2:]:
+        if not line.startswith("|"):
+            break
+        rows.append([cell.strip() for cell in line.strip().strip("|").split("|")])
+    return rows
+
+
+@pytest.mark.parametrize("exercise,name", READMES)
+def test_the_grading_table_is_the_tests_labels_points_visibility_and_core(exercise, name):
+    """Each row of a README's grading table is a test as a student sees it graded: its label
+    (in the README's language; code spans aside), its points, public or hidden, and whether
+    it is core; every test has its row."""
+    from autograder.i18n import _, set_language
+
+    core_mark = {"README.md": "**core**", "README.ur.md": "**بنیادی**"}[name]
+    set_language("ur" if name == "README.ur.md" else "en")
+    try:
+        wanted = sorted((_(label).replace("`", ""), str(points),
+                         "public" if folder == "public" else "hidden",
+                         core_mark if test in EXERCISES[exercise].core else "")
+                        for test, label, points, folder in _graded_tests(EXERCISES[exercise]))
+    finally:
+        set_language("en")
+    rows = sorted((cells[0].replace("`", ""), *cells[1:]) for cells in _grading_table(
+        readme(exercise, name)))
+    assert [tuple(r) for r in rows] == [tuple(w) for w in wanted]

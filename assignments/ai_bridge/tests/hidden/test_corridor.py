@@ -13,5 +13,5 @@ pytestmark = [pytest.mark.world(WORLD),
 
 @pytest.mark.points(4)
 def test_corridor_reaches_goal(mission, credit):
-    """Corridor: the robot follows it round the turn and stops within 0.3 m of the goal"""
+    """Corridor: round the turn, the robot stops within 0.3 m of the goal, touching nothing"""
     judge_reached(mission, credit, _("corridor"))

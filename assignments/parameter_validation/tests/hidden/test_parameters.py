@@ -55,7 +55,7 @@ def refused(probe, name, value):
 
 @pytest.mark.points(2)
 def test_refuses_out_of_range(student, probe, commands):
-    """Out-of-range speed limits are refused with a reason naming the parameter"""
+    """Out-of-range speed limits are refused with a reason naming them, the old values kept"""
     tried = (("max_linear_speed", 3.0), ("max_linear_speed", -0.1),
              ("max_angular_speed", 2.6), ("max_angular_speed", -1.0))
     for name, value in tried:
@@ -91,7 +91,7 @@ def _after_refusals_hint(got: float, refused_values: list[float]) -> str:
 
 @pytest.mark.points(1)
 def test_refuses_empty_robot_name(student, probe, commands):
-    """An empty robot_name is refused with a reason naming it"""
+    """An empty robot_name is refused with a reason naming it, the old value kept"""
     reason = refused(probe, "robot_name", "")
     if "robot_name" not in reason:
         raise StudentFailure(

@@ -16,7 +16,7 @@ VALID = ("max_linear_speed", 0.8)  # within its range: the node must run with it
 
 @pytest.mark.points(1)
 def test_invalid_override_exits(start_node, probe):
-    """Started with an invalid override, the node exits non-zero and its log names the parameter"""
+    """A valid -p override runs; an invalid one exits non-zero, the log naming the parameter"""
     _reads_a_valid_override(start_node, probe)
     # Overrides the node did refuse, naming them: proof that its startup check exists.
     refused_before: list[tuple[str, float]] = []

@@ -17,7 +17,7 @@ TOLERANCE = 0.03
 
 @pytest.mark.points(2)
 def test_speed_stays_under_limit(student, probe, commands):
-    """Driven at 3.0 m/s by the agent, the robot's measured speed stays within the limit"""
+    """Driven at 3.0 m/s by the agent, the robot's measured speed reaches the limit, never more"""
     ready(probe, commands)
     odom = probe.subscribe(Odometry, "/odom")
     start = probe.now

@@ -49,7 +49,7 @@ def test_node_starts(student, probe, streams):
 
 @pytest.mark.points(3)
 def test_control_rate(run, evidence):
-    """cmd_vel keeps 10 Hz for 12 s of simulation time, with no gap over 0.15 s"""
+    """cmd_vel keeps 10 Hz for 12 s of simulation time (count within 3%), no gap over 0.15 s"""
     require_commands(run)
     require_sim_clock(run, _("the control rate"))
     times = run.command_times()
