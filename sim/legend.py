@@ -14,7 +14,7 @@ from collections.abc import Callable
 
 from sim.i18n import _, get_language
 
-FONT = 0.13  # m: 13 px at the picture's 100 px per metre
+FONT = 0.13  # m, unzoomed: 13 px at the picture's 100 px per metre
 ROW = 0.3  # m between rows
 SWATCH = 0.3  # m
 GAP = 0.06  # m between a swatch and its label
@@ -28,18 +28,22 @@ Item = tuple[str, float, Draw]  # label, swatch width, swatch
 
 def legend_height(width: float, goal: bool, runs: int, replay: bool) -> float:
     """The band's height for a picture ``width`` metres wide."""
-    return len(_rows(_items(goal, runs, replay), width)) * ROW + 0.1
+    k = _zoom(width)
+    return (len(_rows(_items(goal, runs, replay), width / k, k)) * ROW + 0.1) * k
 
 
 def legend_svg(top: float, left: float, width: float, goal: bool, runs: int,
                replay: bool) -> str:
     """The legend's markup: rows from ``top``, within [``left``, ``left + width``]."""
     rtl = get_language() in RTL
-    parts = ['<g class="legend" font-family="sans-serif" '
-             f'font-size="{_num(FONT)}" fill="#333">']
-    for r, row in enumerate(_rows(_items(goal, runs, replay), width)):
-        middle = top + ROW * r + ROW / 2 + 0.05
-        x = left + width if rtl else left
+    k = _zoom(width)
+    room = width / k  # the legend is laid out unzoomed, then zoomed as a whole
+    parts = [f'<g class="legend" transform="translate({_num(left)} {_num(top)}) '
+             f'scale({_num(k)})" font-family="sans-serif" font-size="{_num(FONT)}" '
+             'fill="#333">']
+    for r, row in enumerate(_rows(_items(goal, runs, replay), room, k)):
+        middle = ROW * r + ROW / 2 + 0.05
+        x = room if rtl else 0.0
         for label, swatch, draw in row:
             if rtl:
                 parts += [draw(x - swatch, middle),
@@ -50,6 +54,12 @@ def legend_svg(top: float, left: float, width: float, goal: bool, runs: int,
                 x += _width(label, swatch) + SPACE
     parts.append("</g>")
     return "".join(parts)
+
+
+def _zoom(width: float) -> float:
+    """How much larger than its own units the legend is drawn: a report shows every world
+    at one width, so a wider world's legend grows with it and its text keeps its size."""
+    return max(1.0, width / 4.2)
 
 
 def scale_metres(width: float) -> float:
@@ -69,10 +79,12 @@ def _items(goal: bool, runs: int, replay: bool) -> list[Item]:
     return [*items, (_("collision"), SWATCH, _cross)]
 
 
-def _rows(items: list[Item], width: float) -> list[list[Item]]:
-    """The items in rows no wider than ``width``; the scale bar ends the last one."""
-    metres = scale_metres(width)
-    items = [*items, (_("{metres} m").format(metres=_num(metres)), metres, _scale(metres))]
+def _rows(items: list[Item], width: float, k: float) -> list[list[Item]]:
+    """The items in rows no wider than ``width`` (unzoomed); the scale bar, true to the
+    picture's metres once zoomed by ``k``, ends the last one."""
+    metres = scale_metres(width * k)
+    items = [*items,
+             (_("{metres} m").format(metres=_num(metres)), metres / k, _scale(metres, k))]
     rows: list[list[Item]] = [[]]
     used = 0.0
     for item in items:
@@ -138,11 +150,12 @@ def _cross(x: float, y: float) -> str:
             'stroke-width="0.03"/>')
 
 
-def _scale(metres: float) -> Draw:
-    """A bar ``metres`` long with end ticks."""
+def _scale(metres: float, k: float) -> Draw:
+    """A bar ``metres`` long in the picture (``metres / k`` in the zoomed legend), with
+    end ticks."""
 
     def draw(x: float, y: float) -> str:
-        t, x1 = 0.06, x + metres
+        t, x1 = 0.06, x + metres / k
         return (f'<path class="legend-scale" data-metres="{_num(metres)}" '
                 f'd="M{_num(x)},{_num(y - t)} V{_num(y + t)} M{_num(x)},{_num(y)} '
                 f'H{_num(x1)} M{_num(x1)},{_num(y - t)} V{_num(y + t)}" fill="none" '

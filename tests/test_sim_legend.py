@@ -41,6 +41,15 @@ def _legend(svg: str) -> tuple[ET.Element, list[str]]:
     return legend, [t.text or "" for t in legend.iter(f"{SVG}text")]
 
 
+def _placed(legend: ET.Element) -> tuple[float, float, float]:
+    """Where the legend group is drawn: its left, its top, and its zoom."""
+    found = re.fullmatch(r"translate\(([-\d.]+) ([-\d.]+)\) scale\(([\d.]+)\)",
+                         legend.get("transform", ""))
+    assert found is not None
+    left, top, zoom = (float(v) for v in found.groups())
+    return left, top, zoom
+
+
 def test_the_svg_of_a_run_has_a_legend_and_a_scale_bar() -> None:
     spec = load_world("obstacles")
     svg = trajectory_svg(spec, _recording())
@@ -49,10 +58,11 @@ def test_the_svg_of_a_run_has_a_legend_and_a_scale_bar() -> None:
     scale = next(p for p in legend.iter(f"{SVG}path") if p.get("class") == "legend-scale")
     assert scale.get("data-metres") == "2"  # a third of a 6 m room at most
     x0, x1 = (float(v) for v in re.findall(r"M([-\d.]+),[-\d.]+ V", scale.get("d", "")))
-    assert x1 - x0 == pytest.approx(2.0)  # in the picture's metres
+    left, top, zoom = _placed(legend)
+    assert (x1 - x0) * zoom == pytest.approx(2.0, abs=0.002)  # in the picture's metres
     # Below the arena: the viewBox grew to hold it, and the drawing is as before.
     viewbox = [float(v) for v in ET.fromstring(svg).get("viewBox", "").split()]
-    texts_y = [float(t.get("y", "0")) for t in legend.iter(f"{SVG}text")]
+    texts_y = [top + zoom * float(t.get("y", "0")) for t in legend.iter(f"{SVG}text")]
     assert min(texts_y) > spec.size[1] + 0.1 and max(texts_y) < viewbox[1] + viewbox[3]
     assert svg.count('class="path"') == 1 and svg.count('class="collision"') == 1
 
@@ -79,8 +89,18 @@ def test_a_narrow_world_wraps_its_legend_into_rows() -> None:
     legend, _labels = _legend(trajectory_svg(spec, _recording()))
     rows = {t.get("y") for t in legend.iter(f"{SVG}text")}
     assert len(rows) > 1
+    left, _top, zoom = _placed(legend)
     for text in legend.iter(f"{SVG}text"):  # every label starts inside the picture
-        assert -0.1 <= float(text.get("x", "0")) <= spec.size[0] + 0.1
+        assert -0.1 <= left + zoom * float(text.get("x", "0")) <= spec.size[0] + 0.1
+
+
+def test_the_legend_grows_with_a_wider_world_so_its_text_keeps_its_size() -> None:
+    """A report shows every world at one width: a 6 m room's legend is zoomed by its
+    width over 4.2 m, a 2 m room's not at all."""
+    wide = _placed(_legend(trajectory_svg(load_world("obstacles"), _recording()))[0])[2]
+    narrow_spec = dataclasses.replace(load_world("obstacles"), size=(2.0, 2.0))
+    narrow = _placed(_legend(trajectory_svg(narrow_spec, _recording()))[0])[2]
+    assert (wide, narrow) == (pytest.approx(6.1 / 4.2, abs=0.001), 1.0)  # 6.1: the margins
 
 
 def _report(lang: str, collisions: int) -> str:
