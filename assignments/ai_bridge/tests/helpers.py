@@ -83,8 +83,10 @@ class Mission:
         return max((s for s in self.samples if s.t <= t), key=lambda s: s.t, default=None)
 
     def stopped_at_goal(self, sample: Any) -> bool:
-        """Within REACHED of the goal and slower than STILL: arrived, as the task says."""
-        return self.to_goal(sample) <= REACHED and abs(sample.v) < STILL
+        """Within REACHED of the goal, slower than STILL and turning slower than 5 * STILL
+        rad/s: arrived, as :func:`fly` and the task have it."""
+        return self.to_goal(sample) <= REACHED and abs(sample.v) < STILL \
+            and abs(sample.w) < 5 * STILL
 
 
 def fly(world: Any, probe: Any, student: Any, limit: float) -> Mission:
