@@ -58,7 +58,7 @@ msgstr ""
 
 
 def _course(tmp_path: Path, entries: str, readme: str | None = None,
-            title: str = "Timers: ایک نوڈ") -> Path:
+            title: str = "ایک نوڈ: timers") -> Path:
     """locales/ur/{glossary.yaml, LC_MESSAGES/messages.po, content.po} and one README."""
     folder = tmp_path / "locales" / "ur" / "LC_MESSAGES"
     folder.mkdir(parents=True)
@@ -119,7 +119,7 @@ def test_readme_prose_comments_and_title(tmp_path: Path) -> None:
     readme = (
         '<div dir="rtl" lang="ur">\n'
         "\n"
-        "# Timers: ایک کوڈ\n"                                       # line 3: not the title
+        "# ایک کوڈ: timers\n"                                       # line 3: not the title
         "\n"
         "یہ `node` کوڈ ہے، مگر یہ node نہیں۔\n"                       # line 3
         "\n"
@@ -136,8 +136,8 @@ def test_readme_prose_comments_and_title(tmp_path: Path) -> None:
     course = _course(tmp_path, "", readme)
     path = course / "assignments" / "timers" / "README.ur.md"
     found = _check(course)
-    assert found[0] == (f"{path}:3: ur: the title 'Timers: ایک کوڈ' is not the catalog's title "
-                        "of the exercise, 'Timers: ایک نوڈ'")
+    assert found[0] == (f"{path}:3: ur: the title 'ایک کوڈ: timers' is not the catalog's title "
+                        "of the exercise, 'ایک نوڈ: timers'")
     assert found[1].startswith(f"{path}:5: ur: 'node' goes against")
     assert found[2] == f"{path}:8: ur: a comment in a code block is not translated: " \
                        "'copies the starter'"
@@ -150,7 +150,7 @@ def test_readme_prose_comments_and_title(tmp_path: Path) -> None:
 def test_an_urdu_readme_is_wrapped_right_to_left(tmp_path: Path) -> None:
     """GitHub lays a README out paragraph by paragraph, left to right where a paragraph
     starts with a Latin word: an Urdu README is wrapped in <div dir="rtl">."""
-    wrapped = '<div dir="rtl" lang="ur">\n\n# Timers: ایک نوڈ\n\nیہ ایک نوڈ ہے۔\n\n</div>\n'
+    wrapped = '<div dir="rtl" lang="ur">\n\n# ایک نوڈ: timers\n\nیہ ایک نوڈ ہے۔\n\n</div>\n'
     course = _course(tmp_path, "", wrapped)
     assert _check(course) == []
     bare = wrapped.replace('<div dir="rtl" lang="ur">\n\n', "").replace("\n\n</div>", "")

@@ -209,7 +209,7 @@ def test_score_cli_shows_each_question_and_the_answer_given(tmp_path: Path) -> N
     cli = CliRunner().invoke(quiz_cli, ["score", "rclpy-part2", str(path), "--lang", "en"])
     lines = cli.stdout.splitlines()
     assert " ✘ 3. What is the Global Interpreter Lock (GIL)? (0/1)" in lines
-    assert ("      Incorrect. Your answer: A lock that ROS 2 puts on each topic so that two "
+    assert ("      Incorrect. Your answer: “A lock that ROS 2 puts on each topic so that two "
             "nodes cannot publish …") in lines
     assert " ✔ 2. How do you declare a parameter in a Python ROS 2 node? (1/1)" in lines
     assert " ✘ 1. What is the main purpose of callback groups in rclpy? (0/1)" in lines
@@ -220,8 +220,8 @@ def test_score_cli_shows_each_question_and_the_answer_given(tmp_path: Path) -> N
 
 
 @pytest.mark.parametrize(("question", "answer", "text"), [
-    ("tf", False, "False"), ("tf", "true", "True"), ("num", 0.355, "0.355"),
-    ("all-or-nothing", ["b", "a"], "B, A"), ("order", ["z", "x", "y"], "Z, X, Y")])
+    ("tf", False, "“False”"), ("tf", "true", "“True”"), ("num", 0.355, "0.355"),
+    ("all-or-nothing", ["b", "a"], "“B”, “A”"), ("order", ["z", "x", "y"], "“Z”, “X”, “Y”")])
 def test_an_answer_reads_back_as_the_student_chose_it(question, answer, text) -> None:
     from autograder.quiz.localize import Localizer
     from autograder.quiz.types import question_type

@@ -84,7 +84,7 @@ def test_bad_form_is_a_400_naming_the_problem(server: QuizServer) -> None:
     assert info.value.code == 404
 
 
-URDU_ANSWER = 'آپ کا جواب: <bdi><bdi dir="ltr">8</bdi> بار</bdi>'
+URDU_ANSWER = 'آپ نے جواب دیا: <bdi><bdi dir="ltr">8</bdi> بار</bdi>'
 
 
 @pytest.mark.parametrize(("lang", "said"), [("en", "Your answer: <bdi>8 calls</bdi>"),

@@ -22,8 +22,8 @@ class _Said(click.ClickException):
     English whatever the language)."""
 
     def show(self, file: IO[Any] | None = None) -> None:
-        click.echo(_("Error: {message}").format(message=self.format_message()),
-                   file=file or click.get_text_stream("stderr"))
+        click.echo(_("Error: {message}").format(message=self.format_message()), file=file,
+                   err=file is None)
 
 
 class ProblemsFound(_Said):

@@ -49,7 +49,7 @@ def check_source(files: Mapping[str, bytes], filename: str, shown: str) -> str:
     if not any(_makes_node(source) for source in _texts(files, filename, text)):
         raise SourceRefused(_(
             "{file} creates no ROS node: neither it nor a module beside it subclasses "
-            "rclpy's Node or calls rclpy.create_node.").format(file=shown))
+            "rclpy's `Node` or calls `rclpy.create_node`.").format(file=shown))
     return text
 
 

@@ -38,9 +38,9 @@ def shutdown_race_note(output: str) -> str:
     """A line saying what rclpy's shutdown race is, if ``output`` shows it; else ""."""
     if SHUTDOWN_RACE not in output:
         return ""
-    return _("RuntimeError: Unable to convert call argument '0' to Python object is "
+    return _("`RuntimeError: Unable to convert call argument '0' to Python object` is "
              "rclpy's shutdown race: the signal that stopped the program landed while rclpy "
-             "was converting an incoming message, where except KeyboardInterrupt cannot "
+             "was converting an incoming message, where `except KeyboardInterrupt` cannot "
              "catch it, so it happens only now and then. The exercise READMEs explain it; "
              "error_handling's (\"Shutting down cleanly, every time\") shows how to take "
              "the signals yourself so that it never happens.")

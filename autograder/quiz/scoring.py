@@ -61,7 +61,8 @@ def recorded_language(path: Path | str, quiz: Quiz) -> str | None:
 def check_answers(path: Path | str, quiz: Quiz, data: Any, text: str = "") -> dict[str, Any]:
     """Check the shape of decoded answers; the error names the file, line and id."""
     if not isinstance(data, dict) or not isinstance(data.get("answers"), dict):
-        raise ContentError(path, _('must be a JSON object {{"quiz": ..., "answers": {{...}}}}'))
+        raise ContentError(path, _('must be a JSON object `{{"quiz": ..., "answers": {{...}}}}`')
+                           .format())
     unknown = sorted(set(data) - ANSWERS_KEYS)
     if unknown:
         raise ContentError(path, _("unknown key {key!r} (expected: {known})").format(

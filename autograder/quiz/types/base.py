@@ -13,7 +13,7 @@ from collections.abc import Mapping
 from fractions import Fraction
 from typing import TYPE_CHECKING, Any, ClassVar
 
-from autograder.i18n import _, ngettext
+from autograder.i18n import _, ngettext, pgettext
 from autograder.quiz.localize import Localizer, format_number, terminal
 from autograder.quiz.model import Option, Question, Quiz, check_id
 from autograder.quiz.shuffle import attempt_rng, shuffle_unpinned
@@ -137,7 +137,10 @@ class QuestionType(abc.ABC):
         texts of the options it names, in its order."""
         texts = {v.id: terminal(v.text) for v in self.option_views(quiz, q, None, loc)}
         chosen = value if isinstance(value, list) else [value]
-        return ", ".join(texts.get(str(c), str(c)) for c in chosen)
+        # Each option in quotes: an option may hold commas of its own, and a true/false
+        # option read bare beside the feedback ("Correct. Your answer: False") contradicts it.
+        return pgettext("between the options a student chose", ", ").join(
+            _("“{option}”").format(option=texts.get(str(c), str(c))) for c in chosen)
 
     # One attempt ------------------------------------------------------------------------
 
