@@ -112,13 +112,22 @@ def detect() -> Isolation:
 
 def _probe(isolation: Isolation) -> Isolation:
     """``isolation`` if a test program runs in it as a student's does; else basic, why."""
-    try:
-        probe = subprocess.run(
-            [*run_prefix(isolation),
-             *module_command("autograder.sandbox.isolation", [isolation.mode])],
-            capture_output=True, text=True, timeout=120, cwd=SAFE_CWD)
-    except subprocess.TimeoutExpired:
-        return Isolation("basic", _could_not(isolation), "no answer within 120 s")
+    command = [*run_prefix(isolation),
+               *module_command("autograder.sandbox.isolation", [isolation.mode])]
+    with subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                          text=True, cwd=SAFE_CWD) as running:
+        try:
+            out, err = running.communicate(timeout=120)
+        except BaseException as exc:  # stopped, or no answer: it cleans up on SIGTERM
+            running.terminate()
+            try:
+                running.communicate(timeout=10)
+            except subprocess.TimeoutExpired:
+                running.kill()
+            if isinstance(exc, subprocess.TimeoutExpired):
+                return Isolation("basic", _could_not(isolation), "no answer within 120 s")
+            raise
+    probe = subprocess.CompletedProcess(command, running.returncode, out, err)
     if probe.returncode == 0:
         return isolation
     detail = " / ".join((probe.stdout + probe.stderr).strip().splitlines()[-3:])
@@ -162,13 +171,14 @@ def probe_launch(mode: Mode = "strict") -> str | None:
         process = student_process(script, [], Limits(), domain=0, mode=mode,
                                   course=Path(PACKAGE_PARENT))
         try:
-            process.start()
-        except LaunchFailed as exc:
-            return str(exc)
-        try:
+            try:
+                process.start()
+            except LaunchFailed as exc:
+                return str(exc)
             status = process.wait(60.0)
-        finally:
-            process.stop(grace=1.0)
+        finally:  # also when stopped (see __main__): nothing of the test program is left
+            if process.popen is not None:
+                process.stop(grace=1.0)
             shutil.rmtree(process.workdir, ignore_errors=True)
         expected = f"autograder-probe-ok {student_uid(0)}"
         if status == 0 and expected in process.output_text():
@@ -248,7 +258,22 @@ def close_to_others(paths: list[Path]) -> list[Path]:
     return changed
 
 
+def _stop_as_ctrl_c() -> None:
+    """SIGTERM, SIGHUP, and the grader's death (``PR_SET_PDEATHSIG``) end the probe as
+    Ctrl-C would: its ``finally`` stops the test program and removes its folders."""
+    import ctypes
+    import signal
+
+    def stop(signum: int, frame: object) -> None:
+        raise KeyboardInterrupt
+
+    for sig in (signal.SIGTERM, signal.SIGHUP):
+        signal.signal(sig, stop)
+    ctypes.CDLL(None).prctl(1, signal.SIGTERM, 0, 0, 0)  # PR_SET_PDEATHSIG
+
+
 if __name__ == "__main__":
+    _stop_as_ctrl_c()
     problem = probe_launch(*sys.argv[1:2])  # type: ignore[arg-type]
     if problem is not None:
         print(problem)
