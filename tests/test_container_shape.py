@@ -22,6 +22,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+from shapes import DOCKER_CAPS, POD_CAPS, clean_env, container, world_readable_folder
 
 from autograder.core.exercise import find_exercise
 from autograder.sandbox.sweep import STUDENT_UID_BASE, user_ipc, user_processes
@@ -37,34 +38,10 @@ REPO = Path(__file__).resolve().parent.parent
 MINI = REPO / "tests" / "fixtures" / "mini_course"
 CORPUS = REPO / "tests" / "submissions" / "hostile"
 SOLUTION = MINI / "assignments" / "shout" / "solution"
-# Docker's default capabilities (Gradescope's container), and the five a Kubernetes pod of
-# ours keeps (autograder/templates/ci/k8s-shards.yml): neither has CAP_SYS_ADMIN.
-DOCKER_CAPS = ("chown", "dac_override", "fowner", "fsetid", "kill", "setgid", "setuid",
-               "setpcap", "net_bind_service", "net_raw", "sys_chroot", "mknod", "audit_write",
-               "setfcap")
-POD_CAPS = ("setuid", "setgid", "chown", "fowner", "kill")
-
-
-def _container(caps: tuple[str, ...]) -> list[str]:
-    """A command prefix: a container's root with only ``caps``, and a read-only empty
-    cgroup filesystem, as the issue gives the shape."""
-    bounding = ",".join(["-all", *(f"+{cap}" for cap in caps)])
-    return ["unshare", "--mount", "--propagation", "private", "sh", "-c",
-            "mount -t tmpfs -o ro,size=4k tmpfs /sys/fs/cgroup && "
-            f'exec setpriv --bounding-set={bounding} --inh-caps=-all "$@"', "container"]
-
-
-CONTAINER = _container(DOCKER_CAPS)
-POD = _container(POD_CAPS)
+CONTAINER = container(DOCKER_CAPS)
+POD = container(POD_CAPS)
 # Gradescope's image has its Python in /usr/bin, readable by every user.
 PATH = f"/usr/bin:/bin:{os.environ.get('PATH', '')}"
-
-
-def _world_readable_folder(prefix: str) -> Path:
-    """A folder every user can pass through, as /autograder is (pytest's are 0700)."""
-    folder = Path(tempfile.mkdtemp(prefix=prefix))
-    folder.chmod(0o755)
-    return folder
 
 
 def _left_running(uids: list[int]) -> list[int]:
@@ -77,7 +54,7 @@ def _left_running(uids: list[int]) -> list[int]:
 def course() -> Iterator[Path]:
     """A course of the platform and the mini course's `shout` exercise, as an instructor's
     checkout would be: the bundle is built from it."""
-    folder = _world_readable_folder("autograder-course-")
+    folder = world_readable_folder("autograder-course-")
     for name in ("pyproject.toml", "README.md", "tasks.py", "Makefile", "babel.cfg",
                  "autograder", "sim", "locales"):
         source = REPO / name
@@ -97,7 +74,7 @@ def gradescope(course: Path) -> Iterator[Path]:
     run as shipped (in the container shape, from Gradescope's /usr/bin/python3)."""
     from autograder.commands.release import build_gradescope_bundle
 
-    root = _world_readable_folder("autograder-gs-")
+    root = world_readable_folder("autograder-gs-")
     old = os.environ.get("AUTOGRADER_COURSE")
     os.environ["AUTOGRADER_COURSE"] = str(course)
     try:
@@ -120,9 +97,7 @@ def gradescope(course: Path) -> Iterator[Path]:
 
 
 def _clean_env() -> dict[str, str]:
-    """The environment a container starts with: none of this venv's or this course's."""
-    keep = ("HOME", "LANG", "LC_ALL", "TZ", "TMPDIR")
-    return {**{k: v for k, v in os.environ.items() if k in keep}, "PATH": PATH}
+    return clean_env(PATH)
 
 
 def _run_autograder(root: Path, submission: Path) -> tuple[dict, str]:
@@ -221,7 +196,7 @@ def test_a_batch_keeps_each_students_files_from_the_others(gradescope, venv, cou
     """The Kubernetes Job's command: grade-batch over a class folder, in the same shape.
     Students cannot read each other's submissions or reports, and every grade is
     official."""
-    work = _world_readable_folder("autograder-k8s-")
+    work = world_readable_folder("autograder-k8s-")
     try:
         submissions = work / "submissions"
         for name, source in (("alice", CORPUS / "reads_classmates"), ("bob", SOLUTION),
