@@ -217,6 +217,7 @@ def _run(exercise: str, submission: Path, hidden: bool, outputs: dict[str, Path 
          rtf: float | None, domain: int | None, record: Path | None = None,
          module_jobs: int | str = "auto", require_official: bool = False) -> None:
     from autograder.commands.ending import Stopped
+    from autograder.commands.written import say_written
     from autograder.core.report import RawTest
     from autograder.core.submission import SubmissionNotFound, check
     from autograder.grading.run import grade, result_of
@@ -261,7 +262,7 @@ def _run(exercise: str, submission: Path, hidden: bool, outputs: dict[str, Path 
     click.echo(to_terminal(result, color=color, shown=live.shown, with_heading=False,
                            verbose=click.get_current_context().meta.get(VERBOSE, False)))
     _say_recorded(result, record)
-    _say_written(written)
+    say_written(written)
     if result.grader_error:
         raise GraderFault(result.grader_error)
 
@@ -279,20 +280,6 @@ def _say_recorded(result, record: Path | None) -> None:  # noqa: ANN001 - a RunR
             count=len(bags), path=record)), err=True)
     for warning in result.data.get("warnings", []):
         click.echo(for_terminal(_("Warning: {message}").format(message=warning)), err=True)
-
-
-def _say_written(written: list[tuple[str, Path]]) -> None:
-    """Where each requested file went (on stderr, which a pipe on stdout leaves alone)."""
-    from autograder.render.terminal import for_terminal
-
-    for name, path in written:
-        if name == "html":
-            line = _("Wrote {path} (--html): open it in a browser.").format(path=path)
-        elif name == "log":
-            line = _("Wrote {path}: the programs' whole output.").format(path=path)
-        else:
-            line = _("Wrote {path} (--{option}).").format(path=path, option=name)
-        click.echo(for_terminal(line), err=True)
 
 
 def write_outputs(result, outputs: dict[str, Path | None],  # noqa: ANN001

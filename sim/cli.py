@@ -194,8 +194,11 @@ def run_world(spec, *, rtf: float, duration: float | None, domain: int,  # noqa:
     recording = bridge.recording
     if record:
         record.write_text(json.dumps(recording.to_dict(), indent=1), encoding="utf-8")
+        click.echo(_("Wrote {path} (--{option}).").format(path=record, option="record"),
+                   err=True)
     if svg:
         svg.write_text(trajectory_svg(spec, recording), encoding="utf-8")
+        click.echo(_("Wrote {path} (--{option}).").format(path=svg, option="svg"), err=True)
     return "\n".join([*notes, _summary(spec, bridge, effective)])
 
 

@@ -232,6 +232,9 @@ def test_a_closed_pipe_is_no_error_and_every_file_is_written(name: str, work: Wo
     """``| head -1``: check goes on grading and writes its files; a hand run (running until
     stopped) ends as Ctrl-C ends it, its picture written; both exit 0."""
     case = COMMANDS[name]
+    if name == "check":  # every format there is
+        case = dataclasses.replace(case, args=lambda w: [
+            *COMMANDS["check"].args(w), "--gradescope", "g.json", "--junit", "j.xml"])
     process = started(case, work, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
     try:
         assert process.stdout is not None
@@ -249,6 +252,8 @@ def test_a_closed_pipe_is_no_error_and_every_file_is_written(name: str, work: Wo
         assert results["score"] == results["max_score"] > 0
         assert (work.folder / "r.html").read_text().rstrip().endswith("</html>")
         assert (work.folder / "r.log").exists()
+        assert json.loads((work.folder / "g.json").read_text())["score"] > 0
+        assert (work.folder / "j.xml").read_text().rstrip().endswith("</testsuites>")
     else:
         assert (work.folder / "path.svg").read_text().rstrip().endswith("</svg>")
     assert_nothing_left(work, first.decode(errors="replace"))
@@ -300,3 +305,38 @@ def test_nohup_and_setsid_keep_a_command_past_its_parent() -> None:
         kept = subprocess.run([*prefix, sys.executable, "-c", probe], env=env,
                               capture_output=True, text=True, check=True)
         assert kept.stdout.split() == ["0", "0"], prefix
+
+
+def test_a_reader_gone_before_the_first_line_is_no_error(tmp_path: Path) -> None:
+    """``autograder list | true``: nothing is printed to a traceback, and the status is 0."""
+    read, write = os.pipe()
+    os.close(read)  # the reader is gone before anything is written
+    try:
+        done = subprocess.run([AUTOGRADER, "list"], stdout=write, stderr=subprocess.PIPE,
+                              text=True, timeout=60, cwd=REPO)
+    finally:
+        os.close(write)
+    assert (done.returncode, done.stderr) == (0, "")
+
+
+def test_quiz_score_writes_its_files_first_and_says_where(tmp_path: Path) -> None:
+    quiz = json.loads(subprocess.run([AUTOGRADER, "list", "--json"], capture_output=True,
+                                     text=True, check=True, cwd=REPO).stdout)["quizzes"][0]
+    answers = tmp_path / "answers.json"
+    answers.write_text(subprocess.run([AUTOGRADER, "quiz", "key", quiz["id"]], cwd=REPO,
+                                      capture_output=True, text=True, check=True).stdout)
+    read, write = os.pipe()
+    os.close(read)
+    try:
+        done = subprocess.run([AUTOGRADER, "quiz", "score", quiz["id"], str(answers),
+                               "--results", str(tmp_path / "r.json"),
+                               "--html", str(tmp_path / "r.html")],
+                              stdout=write, stderr=subprocess.PIPE, text=True, timeout=60,
+                              cwd=REPO)
+    finally:
+        os.close(write)
+    assert done.returncode == 0, done.stderr
+    assert json.loads((tmp_path / "r.json").read_text())["score"] > 0
+    assert (tmp_path / "r.html").read_text().rstrip().endswith("</html>")
+    assert f"Wrote {tmp_path / 'r.json'} (--results)." in done.stderr
+    assert f"Wrote {tmp_path / 'r.html'} (--html): open it in a browser." in done.stderr

@@ -16,6 +16,7 @@ from typing import Any, TypeVar
 import click
 
 from autograder.commands.exits import UsageProblem, report_problems
+from autograder.commands.written import say_written
 from autograder.core.errors import ContentError
 from autograder.core.results import RunResult
 from autograder.i18n import (
@@ -250,6 +251,7 @@ def score_command(quiz: str, answers: Path, lang: str | None, results: Path | No
     if html:
         html.parent.mkdir(parents=True, exist_ok=True)
         html.write_text(render_result(qf.quiz, result, given, retake=False), encoding="utf-8")
+    say_written((name, path) for name, path in (("results", results), ("html", html)) if path)
     if as_json:
         click.echo(data)
         return
