@@ -16,6 +16,19 @@ def test_a_flood_is_counted_not_kept(monkeypatch):
     assert inbox.dropped == 2
 
 
+def test_each_message_keeps_the_wall_time_it_was_sent_at_beside_its_stamp(monkeypatch):
+    """A kept message's source time stays paired with its sim stamp, a flood's dropped
+    ones take none, and clear() forgets both."""
+    monkeypatch.setattr(Inbox, "LIMIT", 2)
+    inbox: Inbox[str] = Inbox("/cmd_vel")
+    inbox.add(1.0, "a", 100.25)
+    inbox.add(1.1, "b")
+    inbox.add(1.2, "c", 100.45)
+    assert inbox.sent == [(1.0, 100.25), (1.1, None)]
+    inbox.clear()
+    assert inbox.sent == [] and len(inbox) == 0
+
+
 def test_wait_until_wakes_on_the_arrival_that_makes_it_true():
     inbox: Inbox[str] = Inbox("/cmd_vel")
     sender = threading.Thread(target=lambda: [inbox.add(0.0, "go"), inbox.add(0.1, "stop")])

@@ -43,6 +43,9 @@ class Inbox(Generic[M]):
     def __init__(self, topic: str) -> None:
         self.topic = topic
         self._items: list[tuple[float, M]] = []
+        # Each message's DDS source timestamp (wall seconds; None: not known), beside
+        # _items: how a stream's intervals look in wall time tells which clock timed it.
+        self._sent: list[float | None] = []
         self._lock = threading.Condition()
         self._arrivals = 0  # counts dropped messages too: a flood is not quiet
         self.subscription: Any = None
@@ -55,10 +58,11 @@ class Inbox(Generic[M]):
     # A flood must not exhaust the grader's memory: past this, messages are only counted.
     LIMIT = 100_000
 
-    def add(self, stamp: float, message: M) -> None:
+    def add(self, stamp: float, message: M, sent: float | None = None) -> None:
         with self._lock:
             if len(self._items) < self.LIMIT:
                 self._items.append((stamp, message))
+                self._sent.append(sent)
             else:
                 self.dropped += 1
             self._arrivals += 1
@@ -105,6 +109,12 @@ class Inbox(Generic[M]):
     def times(self) -> list[float]:
         return [t for t, _ in self.items]
 
+    @property
+    def sent(self) -> list[tuple[float, float | None]]:
+        """(sim stamp, wall time it was sent at) for each message, in arrival order."""
+        with self._lock:
+            return [(t, w) for (t, _m), w in zip(self._items, self._sent, strict=True)]
+
     def since(self, stamp: float) -> list[M]:
         return [m for t, m in self.items if t >= stamp]
 
@@ -115,6 +125,7 @@ class Inbox(Generic[M]):
     def clear(self) -> None:
         with self._lock:
             self._items.clear()
+            self._sent.clear()
 
 
 class Probe:
@@ -149,8 +160,9 @@ class Probe:
         for tap in self._taps:
             tap(topic, type_name(type(message)), message, stamp)
 
-    def _received(self, topic: str, inbox: Inbox[Any], stamp: float, message: Any) -> None:
-        inbox.add(stamp, message)
+    def _received(self, topic: str, inbox: Inbox[Any], stamp: float, message: Any,
+                  sent: float | None = None) -> None:
+        inbox.add(stamp, message, sent)
         world = (*getattr(self.world, "PUBLISHES", ()), *getattr(self.world, "SUBSCRIBES", ()))
         if topic not in world:
             self._tap(topic, message, stamp)
@@ -227,7 +239,7 @@ class Probe:
             def record(message: Any, info: dict[str, Any]) -> None:
                 source = info.get("source_timestamp") if isinstance(info, dict) else None
                 at = min(sent_at(source), self.now) if source else self.now
-                self._received(name, inbox, at, message)
+                self._received(name, inbox, at, message, source / 1e9 if source else None)
 
             inbox.subscription = self.node.create_subscription(msg_type, topic, record, qos)
         else:

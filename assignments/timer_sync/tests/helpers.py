@@ -10,7 +10,7 @@ tick slow to react shows 0.15 s (RTF 1) and still keeps its beat; 0.2 s is a los
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 from autograder.core.errors import StudentFailure
@@ -61,6 +61,9 @@ FROZEN = 3.0
 # control (2 s) ends 0.25 s or more before the public run does (see END_AT).
 FROZEN_AT_END = 1.0
 MAX_GAP = 0.15 + 1e-6
+# Wall seconds between cmd_vel beats at half pace (median) under which the node keeps the
+# wall clock: 0.1 s there, 0.2 s on /clock.
+WALL_BEAT = 0.15
 RATE_TOLERANCE = 0.03
 
 
@@ -83,6 +86,8 @@ class Run:
     statuses: list[tuple[float, Any]]
     plans: list[tuple[float, Any]]
     frozen_at: float | None = None
+    # Each command's sim stamp and the wall time it was sent at (its DDS source stamp).
+    sent: list[tuple[float, float | None]] = field(default_factory=list)
     # Where the half-pace phase ended (None: at ``end``; the hidden run's is a short one).
     slow_until: float | None = None
 
@@ -163,7 +168,7 @@ def observe(probe, world, streams: Streams, end_at: float = END_AT,
         back = [t for t, to in world.pace_changes if t >= slow_until - 1e-9 and to == watched]
         slow_until = back[0] if back else slow_until
     return Run(start, switch, end, commands.items, streams.statuses.items,
-               streams.plans.items, frozen, slow_until)
+               streams.plans.items, frozen, commands.sent, slow_until)
 
 
 def _let_in_flight_arrive(probe, commands, end: float) -> None:
@@ -272,6 +277,13 @@ def wall_clock_evidence(run: Run) -> str | None:
     seconds = run.slow_end - run.switch
     count = len(run.command_times(run.switch, run.slow_end))
     if seconds <= 0 or not too_fast(count, seconds, CONTROL_HZ):
+        return None
+    # Counted in a short window, a tick at each edge can make one or two too many; the
+    # same beats in wall time cannot lie: 0.1 s apart on the wall clock, 0.2 s and more
+    # on /clock at half pace (the world never runs faster than its pace).
+    sent = sorted(w for t, w in run.sent if w is not None and run.switch <= t < run.slow_end)
+    apart = sorted(b - a for a, b in zip(sent, sent[1:], strict=False))
+    if len(apart) < 3 or apart[len(apart) // 2] > WALL_BEAT:
         return None
     return _("With the world at half speed, cmd_vel came {count} times in {seconds:.2f} s of "
              "simulation time ({rate:.1f} Hz): the node's timers keep the wall clock, not "

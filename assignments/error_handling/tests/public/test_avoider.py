@@ -138,8 +138,7 @@ def test_watchdog_stops(avoider, feeder, probe, commands):
                      "Twist on every 10 Hz cycle once 0.5 s pass without a scan.",
                      len(moving)).format(count=len(late), moving=len(moving),
                                          got=describe(moving[0])),
-            _("Remember when the last scan came (self.get_clock().now()); in the timer, "
-              "publish Twist() when it is more than 0.5 s old."))
+            _late_watchdog_hint(commands, silent, probe.world.real_time_factor))
     if len(late) < 13:
         raise StudentFailure(
             ngettext("With no scan for 2.5 s of simulation time, cmd_vel was published {count} "
@@ -151,6 +150,25 @@ def test_watchdog_stops(avoider, feeder, probe, commands):
             _("Publish the stop from the 10 Hz timer on every cycle while the last scan is "
               "more than 0.5 s old, not once and not from the scan callback."))
     settle_forward(probe, commands, feeder, avoider)
+
+
+def _late_watchdog_hint(commands, silent: float, pace: float) -> str:
+    """The fix, by when the node stopped on its own: never, or late; and late by as much
+    as 0.5 s of wall time makes at the world's pace (a watchdog on the wall clock)."""
+    stops = [t for t, m in commands.items if t >= silent and is_zero(m)]
+    if not stops or stops[-1] < silent + 0.5 or not pace > 0:
+        return _("Remember when the last scan came (self.get_clock().now()); in the timer, "
+                 "publish Twist() when it is more than 0.5 s old.")
+    after = stops[0] - silent
+    if abs(after - 0.5 * pace) <= 0.3:
+        return _("It stopped {after:.2f} s of simulation time after the last scan: 0.5 s of "
+                 "wall time at the grader's {pace:g} times real time. The watchdog measures "
+                 "the wall clock (time.time, time.monotonic); take the scan's age from "
+                 "self.get_clock().now(), which follows /clock.").format(after=after,
+                                                                         pace=pace)
+    return _("It stopped {after:.2f} s after the last scan, not once the scan was 0.5 s "
+             "old: compare the scan's age with 0.5 s on every 10 Hz cycle.").format(
+        after=after)
 
 
 @pytest.mark.points(2)

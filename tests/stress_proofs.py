@@ -1,0 +1,138 @@
+"""One submission, one score, under load: grade known-bad variants beside busy loops, again
+and again, and check that each loses exactly its expected set every time.
+
+Not part of the suite (it takes minutes per exercise). Each round grades every chosen
+variant (two at a time, as ``grade-batch --jobs 2`` does on a 2-core machine) while
+``--busy`` processes spin ``while True: pass``; a variant passes when every round lost
+exactly its ``loses`` and its feedback fits ``says`` and ``not_says``::
+
+    python tests/stress_proofs.py                          # every exercise, every known-bad
+    python tests/stress_proofs.py timer_sync callback_groups:shared_group,deadlock
+    python tests/stress_proofs.py error_handling --repeats 3 --correct
+
+Exit status 0: every variant exact in every round; 1: some were not (each difference
+printed with what the lost tests said).
+"""
+
+from __future__ import annotations
+
+import argparse
+import subprocess
+import sys
+import tempfile
+import time
+from collections import Counter
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+from proving import (
+    JOBS,
+    NOT_PROOFS,
+    SUBMISSIONS,
+    Variant,
+    failures,
+    feedback_mismatches,
+    load_variants,
+)
+
+from autograder.core.exercise import find_exercise
+from autograder.core.results import RunResult
+from autograder.grading.run import grade
+
+BUSY = "while True: pass"
+
+
+def _chosen(specs: list[str], correct: bool) -> list[tuple[str, Variant]]:
+    """(exercise, variant) for each ``EXERCISE`` or ``EXERCISE:NAME,NAME`` asked for."""
+    if not specs:
+        specs = sorted(p.name for p in SUBMISSIONS.iterdir()
+                       if p.is_dir() and p.name not in NOT_PROOFS)
+    kinds = ("mutant", "broken", "correct") if correct else ("mutant", "broken")
+    chosen = []
+    for spec in specs:
+        exercise_id, _sep, names = spec.partition(":")
+        variants = load_variants(find_exercise(exercise_id))
+        wanted = names.split(",") if names else [n for n, v in variants.items()
+                                                  if v.kind in kinds]
+        unknown = set(wanted) - set(variants)
+        if unknown:
+            raise SystemExit(f"{exercise_id}: no variants {', '.join(sorted(unknown))}")
+        chosen += [(exercise_id, variants[name]) for name in wanted]
+        if correct and not names:
+            solution = find_exercise(exercise_id).solution
+            chosen.append((exercise_id, Variant("reference", solution.parent, "correct",
+                                                "the reference solution", frozenset())))
+    return chosen
+
+
+def _difference(result: RunResult, variant: Variant) -> str | None:
+    """What differs from the expectation in one grading (None: nothing)."""
+    if result.grader_error is not None:
+        return f"grader error: {result.grader_error}"
+    lost = {t.name for t in result.tests if t.status != "passed"}
+    parts = []
+    if lost != variant.loses:
+        parts.append(f"lost {sorted(lost)}; expected {sorted(variant.loses)}")
+    wrong = feedback_mismatches(result, variant)
+    if wrong:
+        parts.append(f"feedback: {wrong}")
+    return "; ".join(parts) or None
+
+
+def _round(chosen: list[tuple[str, Variant]], workdir: Path,
+           jobs: int) -> list[RunResult]:
+    with ThreadPoolExecutor(max_workers=jobs) as pool:
+        futures = []
+        for exercise_id, variant in chosen:
+            exercise = find_exercise(exercise_id)
+            folder = variant.submission(exercise, workdir / exercise_id)
+            futures.append(pool.submit(grade, exercise, folder))
+        return [f.result() for f in futures]
+
+
+def main(argv: list[str]) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("specs", nargs="*", metavar="EXERCISE[:VARIANT,...]")
+    parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--busy", type=int, default=2, help="busy loops beside the gradings")
+    parser.add_argument("--jobs", type=int, default=JOBS, help="gradings at a time")
+    parser.add_argument("--correct", action="store_true",
+                        help="also the reference and the correct designs (they must "
+                             "lose nothing)")
+    args = parser.parse_args(argv)
+    chosen = _chosen(args.specs, args.correct)
+    print(f"{len(chosen)} variants x {args.repeats} rounds, {args.jobs} gradings at a time, "
+          f"beside {args.busy} busy loops", flush=True)
+    exact: Counter[str] = Counter()
+    differences: dict[str, list[str]] = {}
+    busy = [subprocess.Popen([sys.executable, "-c", BUSY]) for _ in range(args.busy)]
+    started = time.monotonic()
+    try:
+        with tempfile.TemporaryDirectory() as tmp:
+            for round_ in range(1, args.repeats + 1):
+                results = _round(chosen, Path(tmp), args.jobs)
+                for (exercise_id, variant), result in zip(chosen, results, strict=True):
+                    key = f"{exercise_id}/{variant.name}"
+                    difference = _difference(result, variant)
+                    if difference is None:
+                        exact[key] += 1
+                    else:
+                        differences.setdefault(key, []).append(
+                            f"round {round_}: score {result.score}/{result.max_score}: "
+                            f"{difference}\n      said: {failures(result)}")
+                print(f"round {round_} done, {time.monotonic() - started:.0f} s",
+                      flush=True)
+    finally:
+        for process in busy:
+            process.kill()
+            process.wait()
+    for exercise_id, variant in chosen:
+        key = f"{exercise_id}/{variant.name}"
+        print(f"{key}: exact in {exact[key]}/{args.repeats}")
+        for line in differences.get(key, []):
+            print(f"    {line}")
+    return 1 if differences else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
