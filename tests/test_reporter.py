@@ -25,6 +25,7 @@ title: "Mini: the reporter's exercise"
 file: mini.py
 node: mini
 hidden_visibility: hidden
+core: [test_worth_three, test_secret]
 """
 
 
@@ -310,6 +311,9 @@ def test_points_and_visibility_come_from_markers_and_folders(
         "hidden", "status")
     assert (tests["test_open_secret"]["visibility"],
             tests["test_open_secret"]["reveal"]) == ("visible", "message")
+    # exercise.yaml's core tests are marked, so the lines printed as tests end can say so.
+    assert {name for name, t in tests.items() if t["core"]} == {"test_worth_three",
+                                                                "test_secret"}
 
 
 def test_a_public_run_counts_the_hidden_tests_without_running_them(

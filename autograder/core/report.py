@@ -38,6 +38,7 @@ class RawTest:
     fraction: float | None = None
     charts: list[dict[str, Any]] = dataclasses.field(default_factory=list)
     strangers: list[int] = dataclasses.field(default_factory=list)  # who disturbed it
+    core: bool = False  # named in exercise.yaml's core (the live test lines mark it)
 
 
 @dataclasses.dataclass

@@ -296,7 +296,7 @@ def result_of(raw: RawTest, status: str | None = None,
         max_score=max_score, status=status,  # type: ignore[arg-type]
         message=raw.message if message is None else message, hint=raw.hint,
         visibility=raw.visibility, reveal=raw.reveal,  # type: ignore[arg-type]
-        details=raw.details,
+        details=raw.details, core=raw.core,
         # The test module names the world's recording it ran in (report pictures).
         data={"charts": raw.charts, "nodeid": raw.nodeid, "module": _module_of(raw.nodeid)})
 

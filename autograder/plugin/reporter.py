@@ -94,10 +94,12 @@ class GradingReporter:
     @pytest.hookimpl(trylast=True)
     def pytest_collection_modifyitems(self, config: pytest.Config,
                                       items: list[pytest.Item]) -> None:
+        core: tuple[str, ...] = ()
         if self.exercise:
             from autograder.core.exercise import find_exercise
 
-            self.hidden_default = find_exercise(self.exercise).hidden_visibility
+            found = find_exercise(self.exercise)
+            self.hidden_default, core = found.hidden_visibility, found.core
         settings = config.stash.get(settings_key, None)
         if settings is not None and settings.count_only:
             items[:] = self._count_only(config, items, settings.count_only)
@@ -107,7 +109,7 @@ class GradingReporter:
             self.tests[item.nodeid] = RawTest(
                 nodeid=item.nodeid, name=item.name, label=_label(item),
                 max_score=points,
-                visibility=visibility, reveal=_reveal(item, visibility),
+                visibility=visibility, reveal=_reveal(item, visibility), core=item.name in core,
                 message=_("Not run: the grading run ended before this test."))
         self.write()
 
