@@ -260,6 +260,13 @@ def test_every_format_names_the_core_test_that_kept_it_from_passing(lang, headli
     assert headline in box and "Refuses bad values" in box
 
 
+def test_a_grader_failure_is_not_blamed_on_the_core_tests():
+    run = dataclasses.replace(core_missed(), grader_error="the autograder failed")
+    assert not run.passed
+    assert "core test" not in to_terminal(run) and 'id="core-missed"' not in to_html(run)
+    assert "core test" not in to_gradescope_dict(run)["output"]
+
+
 def test_a_grading_with_every_core_test_passed_says_nothing_of_them():
     run = core_missed()
     run = dataclasses.replace(run, tests=(dataclasses.replace(run.tests[0], core=False),

@@ -21,9 +21,9 @@ def core_label(test: TestResult) -> str:
 def core_heading(result: RunResult) -> str | None:
     """The sentence before the list of core tests that did not pass, or None if every core
     test passed. A whole grading is "not passed" for them; a partial run (``check``) says
-    the grade cannot pass while they fail."""
+    the grade cannot pass while they fail. Nothing when the grader failed: that says so."""
     missed = len(result.core_missed)
-    if not missed:
+    if not missed or result.grader_error:
         return None
     if result.complete:
         return ngettext(
