@@ -422,12 +422,18 @@ def bundle() -> None:
 @bundle.command("gradescope")
 @click.argument("exercise")
 @click.argument("zip_path", metavar="OUT.zip", type=click.Path(path_type=Path, dir_okay=False))
-def bundle_gradescope(exercise: str, zip_path: Path) -> None:
+@click.option("--lang", "grade_lang", type=click.Choice(LANGUAGES), default="en",
+              show_default=True, help="The language its feedback is given in.")
+def bundle_gradescope(exercise: str, zip_path: Path, grade_lang: str) -> None:
     """A Gradescope autograder zip (setup.sh, run_autograder) for EXERCISE."""
     from autograder.commands.release import build_gradescope_bundle
 
-    build_gradescope_bundle(_exercise(exercise), zip_path)
-    click.echo(_("Gradescope autograder written to {path}").format(path=zip_path))
+    try:
+        build_gradescope_bundle(_exercise(exercise), zip_path, grade_lang)
+    except ContentError as exc:
+        raise UsageProblem(str(exc)) from None
+    click.echo(_("Gradescope autograder written to {path}; it grades in {language}.").format(
+        path=zip_path, language=grade_lang))
 
 
 

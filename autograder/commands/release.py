@@ -15,7 +15,9 @@ import zipfile
 from pathlib import Path
 
 from autograder.core.course import course_root
+from autograder.core.errors import ContentError
 from autograder.core.exercise import Exercise, list_exercises
+from autograder.i18n import _, packaged_locales, translations
 
 # The platform itself: what `pip install .` needs and what runs the tests.
 PLATFORM = ("pyproject.toml", "README.md", "tasks.py", "Makefile", "babel.cfg", "autograder",
@@ -112,7 +114,7 @@ VENV="${{AUTOGRADER_VENV:-$ROOT/venv}}"
 mkdir -p "$ROOT/results"
 cd "$ROOT/source"
 AUTOGRADER_COURSE="$ROOT/source" "$VENV/bin/autograder" grade {exercise} "$ROOT/submission" \\
-    --require-official --gradescope "$ROOT/results/results.json" \\
+    --lang {lang} --require-official --gradescope "$ROOT/results/results.json" \\
     --results "$ROOT/results/ours.json"
 status=$?
 if [ ! -s "$ROOT/results/results.json" ]; then
@@ -125,22 +127,36 @@ exit 0
 """
 
 
-def build_gradescope_bundle(exercise: Exercise, zip_path: Path) -> Path:
-    """Write Gradescope's autograder zip for ``exercise``."""
+def build_gradescope_bundle(exercise: Exercise, zip_path: Path, lang: str = "en") -> Path:
+    """Write Gradescope's autograder zip for ``exercise``, grading in ``lang``; a course
+    with no ``lang`` translation of the exercise is an error, never an English bundle."""
     root = course_root()
+    if lang != "en":
+        lookup = translations(lang, "content").pgettext
+        title = lookup(f"exercise:{exercise.id}:title", exercise.title)
+        if title == exercise.title:
+            raise ContentError(exercise.folder, _(
+                "no {lang} translation of the exercise {exercise!r} in the course's catalogs: "
+                "a bundle in {lang} would grade in English").format(lang=lang,
+                                                                   exercise=exercise.id))
     zip_path.parent.mkdir(parents=True, exist_ok=True)
     with zipfile.ZipFile(zip_path, "w", zipfile.ZIP_DEFLATED) as bundle:
         for name, text in (("setup.sh", SETUP_SH),
-                           ("run_autograder", RUN_AUTOGRADER.format(exercise=exercise.id))):
+                           ("run_autograder", RUN_AUTOGRADER.format(exercise=exercise.id,
+                                                                     lang=lang))):
             info = zipfile.ZipInfo(name)
             info.external_attr = (stat.S_IFREG | 0o755) << 16
             bundle.writestr(info, text)
         for name in PLATFORM:
             source = root / name
+            if name == "locales" and not source.exists():
+                source = packaged_locales()  # the platform's own, so it still speaks lang
             paths = [source] if source.is_file() else sorted(source.rglob("*"))
             for path in paths:
-                if path.is_file() and "__pycache__" not in path.parts and path.suffix != ".mo":
-                    bundle.write(path, f"source/{path.relative_to(root)}")
+                if path.is_file() and "__pycache__" not in path.parts and path.suffix != ".mo" \
+                        and not path.is_relative_to(root / "autograder" / "locales"):
+                    bundle.write(path, f"source/{name}/{path.relative_to(source)}"
+                                 if source.is_dir() else f"source/{name}")
         solution = exercise.folder / "solution"  # not needed to grade: never on the image
         for path in sorted(exercise.folder.rglob("*")):
             if path.is_file() and "__pycache__" not in path.parts \

@@ -1,7 +1,7 @@
 """Check a whole course tree before a release: every exercise file loads, its files exist,
 its worlds load, its core tests exist, its reference solution scores 100% (every core test
-passed), its starter does not pass (and fails a core test), and every quiz lints.  Each
-problem is a ``file:line: message``."""
+passed), its starter does not pass (and fails a core test), every quiz lints, and the
+catalogs pass ``i18n check``.  Each problem is a ``file:line: message``."""
 
 from __future__ import annotations
 
@@ -101,7 +101,10 @@ def _gradings(exercise: Exercise, grade: Callable[..., RunResult]) -> list[Probl
 def validate(root: Path | None = None, *, run_gradings: bool = True, jobs: int = 2,
              progress: Callable[[str], None] | None = None) -> list[Problem]:
     """Every problem in the course tree (``root`` defaults to the course in use)."""
+    from autograder.core.course import course_root
     from autograder.grading.run import grade
+    from autograder.i18n import locales_dir
+    from autograder.i18n.cli import check_all
     from autograder.quiz.lint import lint
 
     folder = root / "assignments" if root else assignments_dir()
@@ -132,4 +135,5 @@ def validate(root: Path | None = None, *, run_gradings: bool = True, jobs: int =
             for found in pool.map(check, exercises):
                 problems += found
     problems += lint(root, root / "locales" if root else None)
+    problems += check_all(root / "locales" if root else locales_dir(), root=root or course_root())
     return problems

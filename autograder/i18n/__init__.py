@@ -3,12 +3,15 @@
 Nothing is installed into builtins.  Catalogs live in ``locales/<lang>/LC_MESSAGES/``
 of the course tree as ``.po`` sources; a compiled ``.mo`` beside a source is used when it is
 up to date, otherwise the source is compiled in memory with Babel, so a fresh clone needs
-no build step and a stale ``.mo`` never hides a translation.
+no build step and a stale ``.mo`` never hides a translation.  The platform's own catalogs
+also ship inside the package (``autograder/locales``): a course tree without ``locales/``
+(what the CI recipes point ``AUTOGRADER_COURSE`` at) still speaks the language.
 """
 
 from __future__ import annotations
 
 import gettext as _gettext
+import importlib.resources
 import os
 from functools import cache
 from pathlib import Path
@@ -32,12 +35,26 @@ def locales_dir() -> Path:
     return course_root() / "locales"
 
 
+def packaged_locales() -> Path:
+    """The catalogs shipped inside the package (the checkout's ``locales/``)."""
+    return Path(str(importlib.resources.files("autograder") / "locales"))
+
+
+def catalog_folder(lang: str, domain: str = DOMAIN) -> Path:
+    """Where ``lang``'s ``domain`` catalog is read from: the course's ``locales/`` when it
+    holds that catalog, else the package's."""
+    course = locales_dir() / lang / "LC_MESSAGES"
+    if (course / f"{domain}.po").exists() or (course / f"{domain}.mo").exists():
+        return course
+    return packaged_locales() / lang / "LC_MESSAGES"
+
+
 @cache
 def translations(lang: str, domain: str = DOMAIN) -> _gettext.NullTranslations:
     """Translations for ``lang`` in ``domain``; English (the source) is a null catalog."""
     if lang == "en":
         return _gettext.NullTranslations()
-    return sim.i18n.load_catalog(locales_dir() / lang / "LC_MESSAGES", lang, domain)
+    return sim.i18n.load_catalog(catalog_folder(lang, domain), lang, domain)
 
 
 def set_language(lang: str) -> None:
@@ -46,7 +63,7 @@ def set_language(lang: str) -> None:
     ``autograder``)."""
     global _active
     _active = lang
-    sim.i18n.set_language(lang, locales_dir)
+    sim.i18n.set_language(lang, lambda: catalog_folder(sim.i18n.get_language()).parent.parent)
 
 
 def get_language() -> str:

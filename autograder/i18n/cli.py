@@ -16,7 +16,7 @@ from autograder.core.course import course_root
 from autograder.core.errors import ContentError
 from autograder.i18n import LANGUAGES, _, locales_dir
 from autograder.i18n.glossary import check_language
-from autograder.i18n.tools import check_catalog, compile_catalogs, extract, update
+from autograder.i18n.tools import Problem, check_catalog, compile_catalogs, extract, update
 
 _TARGETS = tuple(lang for lang in LANGUAGES if lang != "en")
 
@@ -72,13 +72,19 @@ def check_command(langs: tuple[str, ...]) -> None:
     """Every template string translated, not fuzzy, placeholders kept; no obsolete entries
     or template headers; the glossary followed in the catalogs and the exercise READMEs
     (file:line: message)."""
-    locales = locales_dir()
-    problems = []
+    report_problems(check_all(locales_dir(), langs, course_root()))
+    click.echo(_("All catalogs are complete."))
+
+
+def check_all(locales: Path, langs: tuple[str, ...] = _TARGETS,
+              root: Path | None = None) -> list[Problem]:
+    """What ``i18n check`` finds: each template's entries translated in each language, and
+    the language rules (glossary, grammar, READMEs) of :func:`check_language`."""
+    problems: list[Problem] = []
     for template in sorted(locales.glob("*.pot")):
         for lang in langs:
             po = locales / lang / "LC_MESSAGES" / f"{template.stem}.po"
             problems += check_catalog(template, po, lang)
     for lang in langs:
-        problems += check_language(locales, lang, course_root())
-    report_problems(problems)
-    click.echo(_("All catalogs are complete."))
+        problems += check_language(locales, lang, root)
+    return problems

@@ -26,7 +26,7 @@ _CODE_SHAPES = (
     # an operator between two operands: "r <= range_max", "angle_max - angle_min"
     re.compile(rf"{_TOKEN}[)\]]* (?:<=|>=|==|!=|<|>|\+|-|\*|/|//|%) [(\[-]*{_TOKEN}"),
     # name=value: "success=true", "angular.z=0"
-    re.compile(r"\b[A-Za-z_][\w.]*=[-+]?(?:[\w.'\"]+|\{\w+\})"),
+    re.compile(r"(?:\b[A-Za-z_][\w.]*|\{[A-Za-z_]\w*\})=[-+]?(?:[\w.'\"]+|\{\w+\})"),
     # a call with arguments: "len(ranges)", "get_logger().error(...)"
     re.compile(r"\b[A-Za-z_][\w.]*\((?=[^()\u0600-\u06ff]*[\w.'\"])[^()\u0600-\u06ff]*\)"),
     # a pair or an interval: "(goal_x, goal_y)", "[-pi, pi]", "[{low}, {high}]" (not a
@@ -95,6 +95,7 @@ _LEAD = re.compile(r"^(?:.*\s(?:میں|پر|سے|تک|بعد|پہلے|ساتھ|�
                    r"|\S+ (?:کا|کی|کے) )*$")
 _MASCULINE_VERB = re.compile(r"(?:تا|گا|سکا|رہا|چکا|ہوا|گیا|دیا|لیا|پایا|تھا)$")
 _FEMININE_VERB = re.compile(r"(?:تی|گی|سکی|رہی|چکی|ہوئی|گئی|دی|لی|پائی|تھی)$")
+_LIGHT_VERB = re.compile(r"(?:کر|کیا|کیے)")
 _AUXILIARY = frozenset({"ہے", "ہیں", "تھا", "تھی", "تھے", "ہو", "ہوں", "گا", "گی", "گے"})
 _NOUNS_LOOKING_LIKE_VERBS = frozenset({"گنتی", "کشتی", "ہستی", "پتا", "ساتھی", "لی", "دی",
                                        "کی", "کیا", "والا", "والی", "سیدھا", "زیادہ", "ٹھیک",
@@ -149,8 +150,8 @@ def agreement(text: str, nouns: Iterable[tuple[str, str, str]],
                         "{found!r}: {term!r} is {gender} in the glossary, and its genitive "
                         "agrees").format(found=f"{before[-1]} {word}", term=en,
                                          gender=_gender_name(gender))
-            if next_word in _POSTPOSITION or not head:
-                continue
+            if next_word in _POSTPOSITION or not head or _LIGHT_VERB.match(next_word):
+                continue  # not the subject: a postposition's, or a compound verb's (جانچ کرنا)
             start = max((m.end() for m in _CLAUSE_END.finditer(bare, 0, found.start())),
                         default=0)
             if not _LEAD.match(bare[start:found.start()]):

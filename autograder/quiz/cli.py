@@ -29,7 +29,14 @@ from autograder.i18n import (
 from autograder.i18n.tools import read_catalog
 from autograder.quiz import CONTENT_DOMAIN
 from autograder.quiz.catalog import find_quiz, list_quizzes, load_all
-from autograder.quiz.localize import Localizer, Text, format_number, format_percent, terminal
+from autograder.quiz.localize import (
+    Localizer,
+    Text,
+    format_number,
+    format_percent,
+    require_translation,
+    terminal,
+)
 from autograder.quiz.model import Quiz
 from autograder.quiz.render import render_markdown, render_page, render_result
 from autograder.quiz.scoring import (
@@ -129,6 +136,7 @@ def render_command(quizzes: tuple[str, ...], lang: str | None, fmt: str, seed: s
     for qf in files:
         for code in langs_for(qf.quiz):
             _use_lang(code)
+            require_translation(qf, code)
             if fmt in ("html", "both"):
                 path = out / f"{qf.quiz.id}.{code}.html"
                 path.write_text(render_page(qf.quiz, code, seed), encoding="utf-8")
@@ -160,6 +168,9 @@ def export_command(quizzes: tuple[str, ...], fmt: str, lang: str | None,
 
     _use_lang(lang)
     files = [find_quiz(q) for q in quizzes] if quizzes else load_all()
+    for qf in files:
+        for code in ((lang or "en",) if fmt == "qti" else (lang,) if lang else qf.quiz.languages):
+            require_translation(qf, code)
     name = files[0].quiz.id if len(files) == 1 else "quizzes"
     data: str | bytes
     if fmt == "moodle-xml":
@@ -186,7 +197,11 @@ SHORT = 72
 
 
 def _short(text: str) -> str:
-    return textwrap.shorten(text, SHORT, placeholder=" …")
+    short = textwrap.shorten(text, SHORT, placeholder=" …")
+    if short.count("`") % 2:  # a code span cut in two: its opening backtick goes too
+        head, _tick, tail = short.rpartition("`")
+        short = head + tail
+    return short
 
 
 def _summary(quiz: Quiz, result: RunResult) -> str:

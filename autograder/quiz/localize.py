@@ -18,9 +18,18 @@ from fractions import Fraction
 from babel import Locale, numbers
 from markupsafe import Markup, escape
 
-from autograder.i18n import get_language, is_rtl, set_language, translations
+from autograder.core.errors import ContentError
+from autograder.i18n import _, get_language, is_rtl, set_language, translations
 from autograder.quiz import CONTENT_DOMAIN
-from autograder.quiz.model import Option, Question, Quiz, context, is_code_only
+from autograder.quiz.model import (
+    Option,
+    Question,
+    Quiz,
+    QuizFile,
+    context,
+    is_code_only,
+    strings,
+)
 
 CODE_SPAN = re.compile(r"`([^`]+)`")
 # A run of Latin script inside right-to-left text: identifiers, English terms, numbers with
@@ -92,6 +101,20 @@ class Localizer:
 
     def option(self, q: Question, o: Option) -> Text:
         return self._lookup(context(self.quiz.id, q.id, f"options.{o.id}"), o.text)
+
+
+def require_translation(qf: QuizFile, lang: str) -> None:
+    """Every string of a quiz translated into ``lang``, or a ContentError naming the first
+    one that is not (its file and line): a page or an export for ``lang`` is never English
+    where a translation is missing."""
+    if lang == "en":
+        return
+    catalog = translations(lang, CONTENT_DOMAIN)
+    for s in strings(qf):
+        if not is_code_only(s.text) and catalog.pgettext(s.context, s.text) == s.text:
+            raise ContentError(qf.path, _(
+                "no {lang} translation of {context} in the course's content catalog: "
+                "run autograder quiz lint").format(lang=lang, context=s.context), s.line)
 
 
 def babel_locale(lang: str) -> Locale:

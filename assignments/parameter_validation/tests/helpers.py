@@ -101,7 +101,7 @@ def accepted_hint(name: str, value: object) -> str:
 def clamp_hint(field: str, name: str, limit: float, asked: float, got: float) -> str:
     """The fix for a clamp that gave ``got`` for ``asked`` under ``limit``."""
     if close(got, asked):
-        return _("{field}={asked} was passed on unclamped: clamp it with "
+        return _("`{field}={asked}` was passed on unclamped: clamp it with "
                  "`max(-limit, min(limit, value))`, where limit is {name}.").format(
             field=field, asked=asked, name=name)
     if close(got, -clamp(asked, limit)):

@@ -140,7 +140,7 @@ def test_accepted_value_applies(student, probe, commands):
             else:
                 hint = clamp_hint(field, name, value, asked, seen)
             raise StudentFailure(
-                _("After {name} was set to {value}, the next command came out as {field}="
-                  "{seen}; expected {expected}.").format(
+                _("After {name} was set to {value}, the next command came out as "
+                  "`{field}={seen}`; expected {expected}.").format(
                     name=name, value=value, field=field, seen=seen, expected=expected),
                 hint)
