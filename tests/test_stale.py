@@ -8,6 +8,7 @@ from __future__ import annotations
 import os
 import re
 import shutil
+import socket
 import subprocess
 import sys
 import tempfile
@@ -18,7 +19,7 @@ from pathlib import Path
 import pytest
 
 from autograder.commands import stale
-from autograder.sandbox.domains import bound_on_domains
+from autograder.sandbox.domains import DOMAIN_GAIN, PORT_BASE, bound_on_domains
 
 REPO = Path(__file__).resolve().parent.parent
 NODES = REPO / "tests" / "fixtures" / "hand_node"
@@ -49,8 +50,13 @@ def left_node(folder: Path, domain: int, user: int | None = None) -> subprocess.
             os.chown(path, user, user)
     prefix = [] if user is None else ["setpriv", f"--reuid={user}", f"--regid={user}",
                                       "--clear-groups"]
-    return subprocess.Popen([*prefix, *IDLE], cwd=workdir, start_new_session=True,
+    node = subprocess.Popen([*prefix, *IDLE], cwd=workdir, start_new_session=True,
                             env={**os.environ, "ROS_DOMAIN_ID": str(domain)})
+    deadline = time.monotonic() + 10
+    while user is not None and Path(f"/proc/{node.pid}").stat().st_uid != user:
+        assert time.monotonic() < deadline, "setpriv never became the user"
+        time.sleep(0.01)  # until setpriv has changed user: a condition, with a deadline
+    return node
 
 
 def test_a_node_in_a_folder_no_world_holds_is_stale_on_its_domain_only(tmp: Path) -> None:
@@ -82,6 +88,20 @@ def test_a_node_whose_world_still_runs_is_not_stale(tmp: Path) -> None:
         node.wait()
 
 
+def test_a_run_finds_what_works_in_its_own_folder_whatever_its_domain(tmp: Path) -> None:
+    """Its backstop when it stops: a program forked while a signal cut its start short."""
+    folder, lock = stale.hand_folder("velocity_governor.py", tmp)
+    node = left_node(folder, 3)
+    try:
+        assert [n.pid for n in stale.working_in(folder)] == [node.pid]
+        stale.stop(stale.working_in(folder))
+        assert node.wait(5) is not None
+    finally:
+        os.close(lock)
+        node.kill()
+        node.wait()
+
+
 def test_a_folder_an_older_version_left_counts_as_stale(tmp: Path) -> None:
     folder = Path(tempfile.mkdtemp(prefix=stale.HAND_PREFIX, dir=tmp))  # no lock file
     node = left_node(folder, 7)
@@ -105,10 +125,13 @@ def test_another_users_node_is_found_with_its_user(tmp: Path) -> None:
         node.wait()
 
 
-def test_a_free_domain_has_no_socket_bound_to_its_ports() -> None:
+def test_a_domain_someone_is_on_is_not_free() -> None:
     free = stale.free_domain(avoid=0)
     assert free is not None and free != 0
-    assert free not in {domain for domain, _uid in bound_on_domains()}
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as bound:  # a participant's
+        bound.bind(("127.0.0.1", PORT_BASE + DOMAIN_GAIN * free))
+        assert (free, os.geteuid()) in bound_on_domains()
+        assert stale.free_domain(avoid=0) != free
 
 
 def _env(tmp: Path) -> dict[str, str]:

@@ -158,6 +158,7 @@ class NodeRun:
                 notes.append(_("Your program {how} at {t:.2f} s of simulation time.").format(
                     how=describe_exit(status), t=self._ended_at))
         if self._folder is not None:
+            stale.stop(stale.working_in(self._folder))  # a start cut short by a signal
             shutil.rmtree(self._folder, ignore_errors=True)
         if self._folder_lock is not None:
             os.close(self._folder_lock)

@@ -109,6 +109,13 @@ def _script(pid: int, folder: Path) -> str:
         return ""
 
 
+def working_in(folder: Path) -> list[StaleNode]:
+    """The programs this process can see working in hand folder ``folder`` (a run's own
+    backstop: one forked while it was being stopped is found here)."""
+    return [StaleNode(pid, uid, folder, "") for pid, uid, cwd in _processes()
+            if (cwd == folder or folder in cwd.parents) and pid != os.getpid()]
+
+
 def find(domain: int, tmp: Path | None = None) -> list[StaleNode]:
     """The stale programs on ``domain`` that this process can see (its user's; everyone's
     for root)."""
