@@ -180,3 +180,26 @@ def _zombie(pid: int) -> bool:
         return Path(f"/proc/{pid}/stat").read_text().rpartition(")")[2].split()[0] == "Z"
     except OSError:
         return True
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(os.geteuid() != 0 or not shutil.which("setpriv"),
+                    reason="needs root to start another user's program")
+def test_a_hand_run_moves_off_a_domain_another_users_node_was_left_on(
+        ros_domain: int, tmp: Path) -> None:
+    folder, lock = stale.hand_folder("velocity_governor.py", tmp)
+    os.close(lock)
+    theirs = left_node(folder, ros_domain, NOBODY)
+    try:
+        done = subprocess.run(_command(ros_domain, "--duration", "1"), env=_env(tmp),
+                              capture_output=True, text=True, timeout=WALL)
+        assert theirs.poll() is None  # not ours to stop
+    finally:
+        theirs.kill()
+        theirs.wait()
+    assert done.returncode == 0, done.stdout + done.stderr
+    moved = re.search(rf"Another user's node, left by a hand run, is on ROS domain "
+                      rf"{ros_domain}, and only they can stop it: this run uses domain (\d+)",
+                      done.stderr)
+    assert moved, done.stderr
+    assert f"on ROS domain {moved.group(1)}," in done.stdout
