@@ -19,6 +19,7 @@ import click
 from autograder import __version__
 from autograder.commands.exits import GraderFault, UsageProblem, report_problems
 from autograder.core.errors import ContentError
+from autograder.core.pid1 import reap_as_init
 from autograder.i18n import LANGUAGES, _, get_language, ngettext, set_language
 
 
@@ -93,6 +94,7 @@ class LazyGroup(click.Group):
               help="Language of what the platform prints (en, ur).")
 def main(lang: str | None) -> None:
     """Grade rclpy exercises in a simulated ROS 2 world, and take quizzes."""
+    reap_as_init()  # a container's first process reaps its orphans (core/pid1.py)
     if lang:
         set_language(lang)
 
