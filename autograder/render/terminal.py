@@ -90,13 +90,13 @@ def rtl_notice(lang: str | None = None, html: Path | None = None,
         return None
     if serve:
         text = _("Most terminals cannot lay out right-to-left text. For the laid-out page "
-                 "run: autograder quiz serve")
+                 "run: `autograder quiz serve`")
     elif html is not None:
         text = _("Most terminals cannot lay out right-to-left text. The laid-out report is "
                  "in {path}: open it in a browser.").format(path=html)
     else:
         text = _("Most terminals cannot lay out right-to-left text. For a laid-out report, "
-                 "run the command again with --html report.html and open that file in a "
+                 "run the command again with `--html report.html` and open that file in a "
                  "browser.")
     return for_terminal(text, lang)
 
