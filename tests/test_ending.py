@@ -340,3 +340,22 @@ def test_quiz_score_writes_its_files_first_and_says_where(tmp_path: Path) -> Non
     assert (tmp_path / "r.html").read_text().rstrip().endswith("</html>")
     assert f"Wrote {tmp_path / 'r.json'} (--results)." in done.stderr
     assert f"Wrote {tmp_path / 'r.html'} (--html): open it in a browser." in done.stderr
+
+
+def test_signals_while_it_cleans_up_do_not_cut_the_cleanup_short() -> None:
+    """A closed terminal sends SIGHUP more than once (to the group, from the shell, at the
+    shell's death): the first stops the command, the rest wait for its cleanup."""
+    probe = ("import os, signal\n"
+             "from autograder.commands.ending import Stopped, handled\n"
+             "with handled() as state:\n"
+             "    try:\n"
+             "        os.kill(os.getpid(), signal.SIGHUP)\n"
+             "        signal.pause()\n"
+             "    except Stopped as stop:\n"
+             "        os.kill(os.getpid(), signal.SIGHUP)\n"
+             "        os.kill(os.getpid(), signal.SIGTERM)\n"
+             "        print('cleaned up after', stop.name)\n"
+             "    print('exit', state.exit_status(0))\n")
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                          env={**os.environ, "PYTHONPATH": str(REPO)}, timeout=60)
+    assert done.stdout.splitlines() == ["cleaned up after SIGHUP", "exit 129"], done.stderr

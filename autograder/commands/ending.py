@@ -58,7 +58,6 @@ class _State:
     signum: int | None = None  # the first signal that stopped it
     pipe_stops: bool = False  # a closed output stops it (see stop_on_closed_pipe)
     pipe_pending: bool = False  # a closed output asked for that stop
-    closed: list[int] = dataclasses.field(default_factory=list)  # fds found closed
     lock: threading.Lock = dataclasses.field(default_factory=threading.Lock)
 
     def on_signal(self, signum: int, _frame: Any) -> None:
@@ -87,11 +86,6 @@ def stop_on_closed_pipe() -> None:
         _state.pipe_stops = True
 
 
-def stopped_by() -> int | None:
-    """The signal that stopped this command, if one did."""
-    return _state.signum if _state is not None else None
-
-
 class _Tolerant(io.FileIO):
     """The file under stdout or stderr: a write to a reader that went away goes to
     /dev/null from then on, and tells the command (:func:`_stream_gone`)."""
@@ -118,7 +112,6 @@ def _stream_gone(fd: int) -> None:
     if state is None:
         return
     with state.lock:
-        state.closed.append(fd)
         ask = state.pipe_stops and not state.pipe_pending and state.signum is None
         state.pipe_pending = state.pipe_pending or ask
     if ask:
