@@ -49,6 +49,14 @@ def test_open_room_reports_arrival(mission):
             _("agent_status said {text!r} while the robot was still {away:.2f} m from the "
               "goal.").format(text=text, away=away),
             _("Report arrival when you are within 0.3 m of the goal, not before."))
+    if abs(state.v) < STILL:  # slow enough, but still turning
+        raise StudentFailure(
+            _("agent_status said {text!r} while the robot, {away:.2f} m from the goal, was "
+              "still turning at {turn:.2f} rad/s.").format(text=text, away=away,
+                                                           turn=abs(state.w)),
+            _("Report once the robot has stopped turning too (slower than {turn} rad/s): the "
+              "odometry's twist.twist.angular.z says how fast it turns.").format(
+                turn=5 * STILL))
     later = mission.arrived_at - stamp
     moving = _("agent_status said {text!r} while the robot, {away:.2f} m from the goal, was "
                "still moving at {speed:.2f} m/s; it stopped {later:.2f} s later.") if later > 0 \
