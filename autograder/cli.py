@@ -639,5 +639,41 @@ def validate(run_gradings: bool, jobs: int, course: Path | None) -> None:
     click.echo(_("The course is valid."))
 
 
+@main.group("new")
+def new_group() -> None:
+    """Scaffold an exercise or a quiz that validates as generated."""
+
+
+def _scaffolded(make: Callable[[], Any]) -> None:
+    try:
+        scaffold = make()
+    except ContentError as exc:
+        raise UsageProblem(str(exc)) from None
+    for path in scaffold.written:
+        click.echo(_("wrote {path}").format(path=path))
+    click.echo(_("Next:"))
+    for number, step in enumerate(scaffold.next_steps, 1):
+        click.echo(f"  {number}. {step}")
+
+
+@new_group.command("exercise")
+@click.argument("exercise_id", metavar="ID")
+def new_exercise_command(exercise_id: str) -> None:
+    """Scaffold assignments/ID/: exercise.yaml, both READMEs, starter, solution, public and
+    hidden tests, and the proof in tests/ (docs/instructors/writing-exercises.md)."""
+    from autograder.commands.new import new_exercise
+
+    _scaffolded(lambda: new_exercise(exercise_id))
+
+
+@new_group.command("quiz")
+@click.argument("quiz_id", metavar="ID")
+def new_quiz_command(quiz_id: str) -> None:
+    """Scaffold quizzes/ID.yaml with each question type once, in English and Urdu."""
+    from autograder.commands.new import new_quiz
+
+    _scaffolded(lambda: new_quiz(quiz_id))
+
+
 if __name__ == "__main__":
     main()

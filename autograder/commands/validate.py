@@ -10,6 +10,7 @@ from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
+from autograder.commands.exercise_checks import check_exercise
 from autograder.core.errors import ContentError
 from autograder.core.exercise import Exercise, assignments_dir, load_exercise, test_names
 from autograder.core.results import RunResult, number
@@ -120,7 +121,8 @@ def validate(root: Path | None = None, *, run_gradings: bool = True, jobs: int =
             problems.append(_from(exc))
             continue
         found = _files(exercise) + _worlds(exercise) + _core(exercise)
-        problems += found
+        # READMEs, grading table, translations, proof: the exercise still grades without.
+        problems += found + check_exercise(exercise, folder.parent)
         if not found:
             exercises.append(exercise)
     if run_gradings:
