@@ -28,6 +28,10 @@ CONCURRENT = 5
 PAUSED_WALL = 0.5
 # Sim seconds test_never_deadlocks lets pass before it reads the rate reports.
 SETTLE = 1.5
+# test_no_fresh_scan: the world's pace while the request waits, and the answer's latency
+# allowed (sim s): 1.0 s of ROS time, less a tick, plus a late answer.
+SLOW_PACE = 0.5
+WAIT_LOW, WAIT_HIGH = 0.9, 1.5
 
 
 @pytest.mark.points(1)
@@ -106,9 +110,17 @@ def test_no_fresh_scan(student, probe, world, alive):
     require_alive(alive)
     start = probe.now
     world.inject(Fault(kind="dropout", start=start, end=start + 3.0))
+    pace = world.real_time_factor
     try:
         probe.wait_sim(0.3)
-        answer = ask(probe)
+        # At half pace a wait timed by the wall clock (1.0 s of it is at most 0.5 s of
+        # simulation time then: the world never runs faster than its pace) is told from
+        # one in ROS time, whatever the machine's load.
+        world.set_real_time_factor(SLOW_PACE)
+        try:
+            answer = ask(probe)
+        finally:
+            world.set_real_time_factor(pace)
     finally:  # scans flow again before the next test
         probe.wait_for(lambda: probe.now > start + 3.3, 4.0)
     response = answer.response
@@ -124,9 +136,8 @@ def test_no_fresh_scan(student, probe, world, alive):
             if response is not None and answer.latency < 0.5 else
             _("Answer only from a scan that arrives after the request; when none comes "
               "within 1.0 s, say so with `success=False`."))
-    # 1.0 s of ROS time is asked for; a wall-clock wait of 1.0 s is let pass (sim time
-    # may run slower than the wall on a busy machine), an answer without waiting is not.
-    if not 0.5 <= answer.latency <= 1.5:
+    # 1.0 s of ROS time is asked for, give or take a tick and a late answer.
+    if not WAIT_LOW <= answer.latency <= WAIT_HIGH:
         raise StudentFailure(
             _("With no scan coming, check_path answered after {latency:.2f} s of simulation "
               "time; it must wait 1.0 s of ROS time for a scan first.").format(
@@ -135,15 +146,15 @@ def test_no_fresh_scan(student, probe, world, alive):
 
 
 def _late_answer_hint(answer: Answer) -> str:
-    """Too short a wait, a wait timed by the wall clock, or a request that waited its
+    """A wait timed by the wall clock, too short a wait, or a request that waited its
     turn: told apart by the answer's latency in simulation and in wall time."""
-    if answer.latency < 0.5:
-        return _("Measure the wait with self.get_clock().now(), which follows /clock.")
     if answer.wall_latency is not None and abs(answer.wall_latency - ANSWER_WITHIN) <= 0.3:
         return _("The answer came {wall:.2f} s of wall time after the request, but {sim:.2f} "
                  "s of simulation time: the wait was timed by the wall clock (time.sleep, "
                  "time.time, a timeout= argument). Measure it with self.get_clock().now(), "
                  "which follows /clock.").format(wall=answer.wall_latency, sim=answer.latency)
+    if answer.latency < WAIT_LOW:
+        return _("Measure the wait with self.get_clock().now(), which follows /clock.")
     return _("The answer came {sim:.2f} s after the request, longer than the 1.0 s wait "
              "itself: the request waited its turn before its callback ran, behind other "
              "callbacks of its callback group. Give the service a callback group of its "
