@@ -18,6 +18,7 @@ import click
 
 from autograder import __version__
 from autograder.commands.exits import GraderFault, UsageProblem, report_problems
+from autograder.core.dumpable import not_dumpable
 from autograder.core.errors import ContentError
 from autograder.core.pid1 import reap_as_init
 from autograder.i18n import LANGUAGES, _, get_language, ngettext, set_language
@@ -94,6 +95,7 @@ class LazyGroup(click.Group):
               help="Language of what the platform prints (en, ur).")
 def main(lang: str | None) -> None:
     """Grade rclpy exercises in a simulated ROS 2 world, and take quizzes."""
+    not_dumpable()  # no program of our user traces (and so stops) or reads the grader
     reap_as_init()  # a container's first process reaps its orphans (core/pid1.py)
     if lang:
         set_language(lang)
@@ -152,8 +154,8 @@ def list_command(as_json: bool) -> None:
         click.echo(json.dumps({
             "exercises": [{"id": e.id, "title": e.title, "file": e.file, "node": e.node,
                            "languages": list(LANGUAGES)} for e in exercises],
-            "quizzes": [{"id": q.id, "title": q.title, "languages": list(q.languages)}
-                        for q in quizzes],
+            "quizzes": [{"id": q.id, "title": q.title, "languages": list(q.languages),
+                         **({"error": q.error} if q.error else {})} for q in quizzes],
         }, ensure_ascii=False, indent=2))
         return
     click.echo(_("Exercises:"))
@@ -162,7 +164,8 @@ def list_command(as_json: bool) -> None:
     if quizzes:
         click.echo(_("Quizzes:"))
         for q in quizzes:
-            click.echo(f"  {q.id:<24} {q.title}")
+            click.echo(f"  {q.id:<24} " + (q.title if not q.error else _(
+                "not loaded: {error}").format(error=q.error)))
 
 
 def _quizzes() -> list:

@@ -62,8 +62,24 @@ class Document:
         return self.lines.get((), 1)
 
     def error(self, message: str, *where: str | int) -> ContentError:
-        field = ".".join(str(w) for w in where) or None
-        return ContentError(self.path, message, self.line(*where), field)
+        return ContentError(self.path, message, self.line(*where), self.field(*where))
+
+    def field(self, *where: str | int) -> str | None:
+        """``where`` as an author reads it: an item of a list by its ``id`` where it has
+        one (``questions[sim-time].answer``), by its index otherwise (``obstacles.2``).
+        Indices shift when an item is added above; ids stay."""
+        parts: list[str] = []
+        node = self.data
+        for step in where:
+            item = node[step] if isinstance(step, int) and isinstance(node, list) \
+                and 0 <= step < len(node) else None
+            if isinstance(item, dict) and isinstance(item.get("id"), str) and parts:
+                parts[-1] += f"[{item['id']}]"
+            else:
+                parts.append(str(step))
+            node = item if item is not None else (
+                node.get(step) if isinstance(node, dict) and isinstance(step, str) else None)
+        return ".".join(parts) or None
 
 
 def _to_python(node: yaml.Node, where: tuple[str | int, ...],

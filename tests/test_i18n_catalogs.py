@@ -148,7 +148,7 @@ def test_malformed_catalog_and_quiz_are_one_line_errors(course: Path) -> None:
     quiz = course / "quizzes" / "part2-rclpy.yaml"
     quiz.write_text(quiz.read_text().replace("type: single", "type: essay", 1))
     code, output = _run("extract")
-    assert code == 2 and "part2-rclpy.yaml:8: questions.0.type" in output
+    assert code == 2 and "part2-rclpy.yaml:8: questions[callback-groups-purpose].type" in output
     assert len(output.strip().splitlines()) == 1
 
 

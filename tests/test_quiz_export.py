@@ -358,7 +358,7 @@ def test_moodle_refuses_a_share_it_has_no_grade_for(tmp_path: Path) -> None:
     path.write_text(f"id: wide\ntitle: Wide\nquestions:\n  - id: many\n    type: multiple\n"
                     f"    partial_credit: true\n    text: Pick.\n    options: [{options}]\n"
                     f"    answer: [{right}]\n")
-    with pytest.raises(ContentError, match=r"wide.yaml:4: questions.0: Moodle has no grade of "
+    with pytest.raises(ContentError, match=r"wide.yaml:4: questions\[many\]: Moodle has no grade of "
                                            r"1/11 of the marks for one answer"):
         export_moodle_xml([load_quiz(path)])
     export_qti([load_quiz(path)])  # QTI maps any share
@@ -607,12 +607,13 @@ def test_export_command_bad_input_exits_2(tmp_path: Path, monkeypatch: pytest.Mo
 
     monkeypatch.setitem(registry(), "no_export", NoExport())
     path = tmp_path / "toy.yaml"
-    path.write_text("id: toy\ntitle: Toy\nquestions:\n  - id: pick\n    type: no_export\n"
+    path.write_text("id: toy\ntitle: Toy\nlanguages: [en]\n"  # English: no catalog needed
+                    "questions:\n  - id: pick\n    type: no_export\n"
                     "    text: Pick.\n    options: [{id: a, text: A}, {id: b, text: B}]\n"
                     "    answer: a\n")
     for fmt in ("moodle-xml", "qti"):
         result = runner.invoke(quiz_cli, ["export", str(path), "--format", fmt,
                                           "--out", str(tmp_path / "x")])
         assert result.exit_code == 2, result.output
-        assert f"toy.yaml:4: questions.0: a no_export question cannot be exported to {fmt}" \
+        assert f"toy.yaml:5: questions[pick]: a no_export question cannot be exported to {fmt}" \
             in result.output

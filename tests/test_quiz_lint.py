@@ -92,7 +92,7 @@ def test_malformed_quiz_and_duplicate_ids_and_tolerance(course: Path) -> None:
     assert code == 1
     assert any(line.startswith(f"{folder / 'broken.yaml'}:3: YAML error") for line in lines)
     assert any("quiz id 'rclpy-part2' is also used by" in line for line in lines)
-    assert any(re.search(r"timer-synchronization.yaml:\d+: questions.1.tolerance", line)
+    assert any(re.search(r"timer-synchronization.yaml:\d+: questions\[calls-in-two-seconds\].tolerance", line)
                for line in lines)
 
 

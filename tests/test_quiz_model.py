@@ -64,9 +64,9 @@ def test_list_quizzes_for_autograder_list(course: Path) -> None:
 
 BROKEN = [
     ("yaml-error", "id: x\ntitle: [unclosed\n", 3, "YAML error"),
-    ("missing-field", GOOD.replace("    text: Pick a\n", ""), 4, "questions.0.text: required"),
+    ("missing-field", GOOD.replace("    text: Pick a\n", ""), 4, "questions[q1].text: required"),
     ("unknown-type", GOOD.replace("type: single", "type: essay"), 5,
-     "questions.0.type: must be one of"),
+     "questions[q1].type: must be one of"),
     ("unknown-field", GOOD.replace("    answer: a", "    answr: a"), 10, "unknown field"),
     ("key-names-no-option", GOOD.replace("answer: a", "answer: c"), 10,
      "the key must be one option id"),
@@ -104,7 +104,7 @@ def test_malformed_quiz_in_cli_is_one_line_and_changes_nothing(course: Path) -> 
     assert result.exit_code == 2
     assert "Traceback" not in result.output
     lines = result.output.strip().splitlines()
-    assert len(lines) == 1 and "part2-rclpy.yaml:8: questions.0.type" in lines[0]
+    assert len(lines) == 1 and "part2-rclpy.yaml:8: questions[callback-groups-purpose].type" in lines[0]
     assert not out.exists()
 
 

@@ -112,7 +112,7 @@ def test_accepted_type_values_are_the_registry_keys(tmp_path: Path) -> None:
     with pytest.raises(ContentError) as info:
         load_quiz(path)
     allowed = ", ".join(repr(name) for name in sorted(registry()))
-    assert str(info.value) == (f"{path}:5: questions.0.type: must be one of {allowed}, "
+    assert str(info.value) == (f"{path}:5: questions[colour].type: must be one of {allowed}, "
                                "found 'any_of'")
 
 
@@ -137,7 +137,7 @@ def test_registered_type_loads_renders_and_scores(any_of: AnyOf) -> None:
 
 
 def test_registered_type_is_checked_by_its_own_rules(any_of: AnyOf) -> None:
-    with pytest.raises(ContentError, match=r"toy.yaml:8: questions.0.answer: the key names no"):
+    with pytest.raises(ContentError, match=r"toy.yaml:8: questions\[colour\].answer: the key names no"):
         load_quiz("toy.yaml", TOY.replace("[red, blue]", "[red, pink]"))
     with pytest.raises(ContentError, match="only a numeric question has a tolerance"):
         load_quiz("toy.yaml", TOY.replace("answer: [red, blue]",

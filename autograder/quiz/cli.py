@@ -28,7 +28,7 @@ from autograder.i18n import (
 )
 from autograder.i18n.tools import read_catalog
 from autograder.quiz import CONTENT_DOMAIN
-from autograder.quiz.catalog import find_quiz, list_quizzes, load_all
+from autograder.quiz.catalog import find_quiz, list_quizzes, load_all, load_each
 from autograder.quiz.localize import (
     Localizer,
     Text,
@@ -40,7 +40,7 @@ from autograder.quiz.localize import (
 from autograder.quiz.model import Quiz
 from autograder.quiz.render import render_markdown, render_page, render_result
 from autograder.quiz.scoring import (
-    key_answers,
+    file_key,
     pass_summary,
     read_answers,
     recorded_language,
@@ -100,11 +100,13 @@ def list_command(as_json: bool) -> None:
     """List the quizzes with their ids, titles and languages."""
     entries = list_quizzes()
     if as_json:
-        click.echo(json.dumps([{"id": e.id, "title": e.title, "languages": list(e.languages)}
+        click.echo(json.dumps([{"id": e.id, "title": e.title, "languages": list(e.languages),
+                                **({"error": e.error} if e.error else {})}
                                for e in entries], ensure_ascii=False, indent=2))
         return
     for e in entries:
-        click.echo(f"{e.id}  {e.title}  [{', '.join(e.languages)}]")
+        click.echo(f"{e.id}  {e.title}  [{', '.join(e.languages)}]" if not e.error else
+                   f"{e.id}  " + _("not loaded: {error}").format(error=e.error))
 
 
 @quiz_cli.command("lint")
@@ -281,7 +283,7 @@ def score_command(quiz: str, answers: Path, lang: str | None, results: Path | No
 @_errors
 def key_command(quiz: str) -> None:
     """Print the answers file that scores full marks (for instructors)."""
-    click.echo(json.dumps(key_answers(find_quiz(quiz).quiz), ensure_ascii=False, indent=2))
+    click.echo(json.dumps(file_key(find_quiz(quiz).quiz), ensure_ascii=False, indent=2))
 
 
 def _ask(kind: QuestionType, view: QuestionView) -> Any:
@@ -348,7 +350,9 @@ def serve_command(port: int, lang: str | None) -> None:
     from autograder.quiz.server import QuizServer
 
     lang = _use_lang(lang)
-    files = load_all()
+    files, errors = load_each()
+    for exc in errors:  # served without it; the others are unaffected
+        click.echo(_("not loaded: {error}").format(error=exc), err=True)
     try:
         server = QuizServer(files, port, lang)
     except OSError as exc:

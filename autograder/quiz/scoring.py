@@ -141,3 +141,11 @@ def result_dict(result: RunResult) -> dict[str, Any]:
 def key_answers(quiz: Quiz) -> dict[str, Any]:
     """The answers file that scores full marks (for instructors only)."""
     return {"quiz": quiz.id, "answers": {q.id: q.key() for q in quiz.questions}}
+
+
+def file_key(quiz: Quiz) -> dict[str, Any]:
+    """The answers file that scores full marks, each answer as the quiz file states its key
+    (``false``, not ``"false"``), so that it also pastes back into ``answer:``."""
+    return {"quiz": quiz.id, "answers": {
+        q.id: list(q.answer) if isinstance(q.answer, tuple) else q.answer
+        for q in quiz.questions}}

@@ -45,7 +45,7 @@ class Languages:
         """A question that cannot be exported, named by its file and line."""
         index = self.quiz.questions.index(q)
         return ContentError(self.qf.path, message, self.qf.line("questions", index),
-                            f"questions.{index}")
+                            self.qf.doc.field("questions", index))
 
     def unsupported(self, q: Question, fmt: str) -> ContentError:
         return self.error(q, _("a {type} question cannot be exported to {format}").format(

@@ -53,8 +53,8 @@ class Numeric(QuestionType):
     def lint_notes(self, q: Question, index: int) -> list[LintNote]:
         if q.answer and q.tolerance >= abs(q.answer):
             return [LintNote("tolerance", _(
-                "questions.{index}.tolerance: a tolerance of {tolerance} around {answer} "
-                "also accepts 0").format(index=index, tolerance=q.tolerance, answer=q.answer))]
+                "questions[{id}].tolerance: a tolerance of {tolerance} around {answer} "
+                "also accepts 0").format(id=q.id, tolerance=q.tolerance, answer=q.answer))]
         return []
 
     def answer_problem(self, q: Question, value: Any) -> str | None:
