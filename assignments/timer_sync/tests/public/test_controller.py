@@ -195,10 +195,20 @@ def test_status_counts(run):
                          "published by then.",
                          "At t={t:.2f} s status said `plans={plans}`, but {seen} plans had been "
                          "published by then.", seen).format(t=t, plans=s["plans"], seen=seen),
-                _("The node counts plans that never came on plan: publish each route on plan "
-                  "(a std_msgs/String) when the planner finishes it, and count it then.")
-                if s["plans"] > seen else
+                _early_count_hint(t, plan_times) if s["plans"] > seen else
                 _("Count a plan when the planner finishes one and report the count."))
+
+
+def _early_count_hint(t: float, plan_times: list[float]) -> str:
+    """Counted ahead of plan: the plan came later (counted when the planner started), or
+    never came."""
+    later = [p for p in plan_times if p > t]
+    if later:
+        return _("The plan it counted came on plan only at t={came:.2f} s: count a plan once "
+                 "the planner has finished and published it, not when it starts.").format(
+            came=later[0])
+    return _("The node counts plans that never came on plan: publish each route on plan "
+             "(a std_msgs/String) when the planner finishes it, and count it then.")
 
 
 def _ticks_hint(items: list[tuple[float, dict[str, int]]], command_times: list[float]) -> str:
