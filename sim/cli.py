@@ -362,7 +362,7 @@ def _summary(spec, bridge, effective: float) -> str:  # noqa: ANN001
         _("Distance travelled: {d:.2f} m").format(d=bridge.recording.distance()),
         _("Collisions: {n}").format(n=len(collisions)),
     ]
-    lines += [_("  at {t:.2f} s with {what}").format(t=c.t, what=c.description)
+    lines += [_("  at {t:.2f} s with {what}").format(t=c.t, what=c.hit_name)
               for c in collisions[:10]]
     if spec.goal is not None:
         reached = math.hypot(x - spec.goal.x, y - spec.goal.y) <= spec.goal.tolerance

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 import pymunk
 
-from sim.i18n import N_, _
+from sim.i18n import N_, NP_, _, pgettext
 from sim.worldfile import ROBOT_RADIUS, Box, Circle, WorldSpec
 
 ROBOT_MASS = 1.0
@@ -48,15 +48,25 @@ except ImportError:  # pragma: no cover - another pymunk layout: the public API 
 _THINGS = {"wall": N_("wall {number}"), "box": N_("box {number}"),
            "circle": N_("circle {number}"), "added box": N_("added box {number}"),
            "added circle": N_("added circle {number}")}
+# The same names where a postposition follows ("hit {what}": Urdu "ڈبے 2 سے", never the
+# direct "ڈبہ 2 سے"); the same words in English.
+_OBLIQUE = "before a postposition"
+_THINGS_OBLIQUE = {"wall": NP_("before a postposition", "wall {number}"),
+                   "box": NP_("before a postposition", "box {number}"),
+                   "circle": NP_("before a postposition", "circle {number}"),
+                   "added box": NP_("before a postposition", "added box {number}"),
+                   "added circle": NP_("before a postposition", "added circle {number}")}
 
 
-def describe(what: str) -> str:
-    """``what`` a contact names ("wall 3", "added box 7"), in the active language."""
+def describe(what: str, oblique: bool = False) -> str:
+    """``what`` a contact names ("wall 3", "added box 7"), in the active language; with
+    ``oblique``, in the form a name takes before a postposition (what a robot hits)."""
     kind, _sep, number = what.rpartition(" ")
-    template = _THINGS.get(kind)
+    template = (_THINGS_OBLIQUE if oblique else _THINGS).get(kind)
     if template is None or not number.isdigit():
         return what  # "?" or a label a test chose
-    return _(template).format(number=number)
+    text = pgettext(_OBLIQUE, template) if oblique else _(template)
+    return text.format(number=number)
 
 
 @dataclass(frozen=True)
@@ -72,6 +82,12 @@ class Contact:
     def description(self) -> str:
         """What it hit, for people, in the active language ("wall 3" in English)."""
         return describe(self.what)
+
+    @property
+    def hit_name(self) -> str:
+        """What it hit, as a sentence that says so names it: before a postposition, in the
+        oblique case ("the robot hit {what}": Urdu "ڈبے 2 سے ٹکرایا")."""
+        return describe(self.what, oblique=True)
 
 
 def _approach(current: float, target: float, max_delta: float) -> float:

@@ -137,7 +137,7 @@ def test_the_starter_is_graded_below_the_pass_mark_with_hints(runs):
     run: Run = runs["grade-starter-en"]
     assert re.search(r"^Score: [\d.]+/13 \(\d+%\), not passed \(pass mark 70%\)$",
                      run.stdout, re.M)
-    assert run.count("Hint: linear.x=3.0 was passed on unclamped: clamp it with "
+    assert run.count("Hint: `linear.x=3.0` was passed on unclamped: clamp it with "
                      "`max(-limit, min(limit, value))`, where limit is max_linear_speed.") == 1
     assert run.results["passed"] is False
 

@@ -49,7 +49,7 @@ def test_driving_head_on_into_a_box_gets_the_note(theta):
     note = front_beam_note(contacts, samples, world.geometry)
     assert note.startswith("The robot drove into added box 4 straight ahead.")  # 4 walls first
     assert "beam 0 of /scan is straight ahead" in note
-    assert "ranges[len(ranges)//2] is straight behind" in note
+    assert "`ranges[len(ranges)//2]` is straight behind" in note
 
 
 def test_the_note_comes_once_on_a_line_of_its_own():

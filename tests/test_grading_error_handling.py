@@ -47,7 +47,7 @@ def test_driving_into_what_is_ahead_is_told_which_beam_is_front(graded):
     message = by_name["test_never_collides"].message
     assert "The robot drove into box 0 straight ahead." in message, message
     assert "beam 0 of /scan is straight ahead" in message
-    assert "ranges[len(ranges)//2] is straight behind" in message
+    assert "`ranges[len(ranges)//2]` is straight behind" in message
     assert message.count("straight ahead.") == 1
 
 

@@ -194,3 +194,24 @@ def test_the_real_readmes_start_every_block_right_to_left() -> None:
         lines = readme.read_text(encoding="utf-8").splitlines()
         heads = [line for line in lines if line.startswith("# ")]
         assert heads and rules.first_strong(heads[0][2:]) == "R", readme
+
+
+def test_what_a_robot_hits_is_named_in_the_oblique(real: Glossary) -> None:
+    """The collision messages put the obstacle's name before سے: the name it is given
+    there is oblique ("ڈبے 2 سے"), which the rule passes and the direct name fails."""
+    from autograder.i18n import _, set_language, translations
+    from sim.physics import Contact
+
+    translations.cache_clear()
+    set_language("ur")
+    try:
+        template = _("The robot hit {what} at ({x:.2f}, {y:.2f}), {seconds:.1f} s into the run.")
+        said = [(template.format(what=contact.hit_name, x=0.5, y=0.5, seconds=1.0),
+                 template.format(what=contact.description, x=0.5, y=0.5, seconds=1.0))
+                for contact in (Contact(t=1.0, x=0.5, y=0.5, what=what)
+                                for what in ("box 2", "circle 1", "added box 3"))]
+    finally:
+        set_language("en")
+    for right, wrong in said:
+        assert not [m for m in _said(real, right) if "oblique" in m], right
+        assert [m for m in _said(real, wrong) if "oblique" in m], wrong

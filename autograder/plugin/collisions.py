@@ -87,7 +87,7 @@ def front_beam_note(contacts: Iterable[Contact], samples: Sequence[Sample],
             return _("The robot drove into {what} straight ahead. On this robot beam 0 of "
                      "/scan is straight ahead (angles run counter-clockwise); check which "
                      "beam your node treats as \"front\" (`ranges[len(ranges)//2]` is "
-                     "straight behind).").format(what=contact.description)
+                     "straight behind).").format(what=contact.hit_name)
     return ""
 
 

@@ -169,7 +169,7 @@ def test_never_collides(run, world, student):
         raise StudentFailure(
             with_front_beam_note(
                 _("The robot hit {what} at ({x:.2f}, {y:.2f}), {seconds:.1f} s into the run.")
-                .format(what=first.description, x=first.x, y=first.y,
+                .format(what=first.hit_name, x=first.x, y=first.y,
                         seconds=first.t - run.start),
                 collisions, samples, world.world.geometry),
             _("Stop going forward when the nearest valid reading within ±30° of ahead is "
@@ -198,7 +198,7 @@ def test_stops_during_dropout(run, world, student):
                      if first else describe(going[0])))
             if hit is not None:
                 message += "\n" + _("Driving on blind, it hit {what} {after:.1f} s after the "
-                                    "last scan.").format(what=hit.description,
+                                    "last scan.").format(what=hit.hit_name,
                                                          after=hit.t - d.start)
             raise StudentFailure(
                 message,
