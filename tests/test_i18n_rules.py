@@ -215,3 +215,13 @@ def test_what_a_robot_hits_is_named_in_the_oblique(real: Glossary) -> None:
     for right, wrong in said:
         assert not [m for m in _said(real, right) if "oblique" in m], right
         assert [m for m in _said(real, wrong) if "oblique" in m], wrong
+
+
+def test_a_rendering_split_over_two_readme_lines_is_caught(tmp_path: Path) -> None:
+    course = _course(tmp_path, readme=(
+        "# ایک نوڈ: timers\n\n"
+        "یہ timer `plan_route()` کو call\n"       # line 5: "call" ends the line
+        "کرتا ہے۔\n"))
+    found = [str(p) for p in check_language(course / "locales", "ur", course)
+             if "'call کر'" in str(p)]
+    assert [re.search(r"README\.ur\.md:(\d+):", f)[1] for f in found] == ["5"], found

@@ -209,6 +209,30 @@ class Glossary:
             index = sum(1 for start in starts or [0] if start <= max(at, 0)) - 1
             yield Problem(file, lines[index], f"{self.language}: {message}")
 
+    def _across_lines(self, path: Path, paragraph: list[tuple[int, str]]) -> list[Problem]:
+        """Forbidden renderings split over two lines of a paragraph ("call" ending one
+        line, "کرتا" starting the next), which the line-by-line check cannot see."""
+        problems = []
+        for rule in self.rules:
+            texts = []
+            for _n, text in paragraph:
+                checked = prose(text.strip())
+                for allowed in rule.allow:
+                    checked = allowed.sub(_CODE_MARK, checked)
+                texts.append(checked)
+            ends = [sum(len(t) + 1 for t in texts[:i + 1]) - 1 for i in range(len(texts))]
+            joined = " ".join(texts)
+            for pattern in rule.forbid:
+                for found in pattern.finditer(joined):
+                    line = next(i for i, end in enumerate(ends) if found.start() < end)
+                    if found.end() > ends[line]:
+                        problems.append(Problem(path, paragraph[line][0], _(
+                            "{lang}: {found!r} goes against the glossary's {term!r} "
+                            "({glossary}:{line}): write {ur}").format(
+                            lang=self.language, found=found.group(0), term=rule.term.en,
+                            glossary=self.path, line=rule.line, ur=rule.term.ur)))
+        return problems
+
     def _latin_runs(self, ur: str, file: Path, line: int, before: str = "") -> Iterator[Problem]:
         if not _URDU.search(ur):
             return  # a line with no Urdu at all (a table rule, a bare name) runs no risk
@@ -286,6 +310,7 @@ class Glossary:
                 starts.append(len(joined))
                 joined += line_text.strip() + " "
             found = list(self.grammar(joined, path, [n for n, _t in paragraph], starts))
+            found += self._across_lines(path, paragraph)
             paragraph.clear()
             return found
 
