@@ -1,15 +1,17 @@
 #!/usr/bin/env python3
 """Set up and run the project's jobs with nothing but Python 3.10+ (make is optional).
 
+    python3 tasks.py setup     # only make .venv and install the platform into it
     python3 tasks.py demo      # grade the reference solution of parameter_validation
-    python3 tasks.py test      # run the tests: the fast tier, under a minute
+    python3 tasks.py test      # the fast tier: 1 to 3 minutes on 2 cores, by load
     python3 tasks.py test-all  # run every test, the gradings in the simulator too (CI)
     python3 tasks.py lint | bench
 
 Arguments after the job go to its command (``python3 tasks.py test -k reporter``).
 
 Each job creates ``.venv`` and installs the project into it first (once; again when
-pyproject.toml changes).
+pyproject.toml changes): the demo without the test tools, the other jobs with them. The
+first run says each step and its size, and ends with the commands to type next.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+import time
 import venv
 from pathlib import Path
 
@@ -32,13 +35,15 @@ STAMP = VENV / ".installed"
 NON_ROS_DEPENDENCIES = ["pymunk>=6.6", "numpy>=1.24", "jinja2>=3.1", "babel>=2.12",
                         "click>=8.1", "pytest>=7.4", "pyyaml>=6.0", "mcap>=1.1",
                         "mcap-ros2-support>=0.5", "ruff>=0.5", "playwright>=1.40",
-                        "kubernetes-validate>=1.37"]
+                        "kubernetes-validate>=1.37", "mkdocs-material>=9.5"]
 
 JOBS = {
+    # Only the set-up: what a student release offers (it has no solution to grade).
+    "setup": [],
     "demo": [["autograder", "grade", "parameter_validation",
               "assignments/parameter_validation/solution"]],
     # The fast tier: everything but the tests marked `slow` (each grades submissions end to
-    # end in the simulator), so a change is checked in under a minute.
+    # end in the simulator): about a minute on an idle 2-core machine, 2 to 3 under load.
     "test": [["python", "-m", "pytest", "-m", "not slow", "--durations=10"]],
     # Everything, as CI runs it (14.5 to 16 minutes). The ten slowest steps close the run:
     # where the suite's minutes go, in every CI log.
@@ -49,19 +54,54 @@ JOBS = {
 }
 
 
-def setup() -> None:
+# The dev extra's packages: only the project's own tests and docs use them, so the demo,
+# a student's set-up, installs without them (playwright alone is 165 MB).
+DEV_ONLY = ("ruff", "playwright", "kubernetes-validate", "mkdocs-material")
+
+
+def _size_mb(folder: Path) -> int:
+    total = 0
+    for path, _dirs, files in os.walk(folder):
+        for name in files:
+            try:
+                total += os.lstat(os.path.join(path, name)).st_size
+            except OSError:
+                pass
+    return round(total / 1e6)
+
+
+def _installed() -> set[str]:
+    """What the venv holds from this checkout: {"base"}, {"base", "dev"}, or nothing (no
+    venv, another checkout's, or pyproject.toml changed since)."""
+    pyproject = ROOT / "pyproject.toml"
+    if not STAMP.exists() or STAMP.stat().st_mtime < pyproject.stat().st_mtime:
+        return set()
+    root, _, extras = STAMP.read_text().partition("\n")
+    return {"base", *extras.split()} if root == str(ROOT) else set()
+
+
+def setup(job: str) -> bool:
+    """Make the venv and install what JOB needs; say each step, its size and its time.
+    True when it installed something."""
     if sys.version_info < (3, 10):  # noqa: UP036 - tasks.py is run by any python3
         sys.exit(f"Python 3.10 or newer is needed (found {sys.version.split()[0]})")
-    pyproject = ROOT / "pyproject.toml"
-    if STAMP.exists() and STAMP.stat().st_mtime >= pyproject.stat().st_mtime \
-            and STAMP.read_text() == str(ROOT):
-        return  # installed, from this checkout, since pyproject.toml last changed
+    dev = job not in ("setup", "demo")
+    have = _installed()
+    if "base" in have and (not dev or "dev" in have):
+        return False  # installed, from this checkout, since pyproject.toml last changed
+    started = time.monotonic()
     # With a sourced system ROS 2 Jazzy (/opt/ros/jazzy, e.g. on an arm64 board), use its
     # rclpy and messages instead of the PyPI wheels, which exist for x86_64 only.
     system_ros = os.environ.get("ROS_DISTRO") == "jazzy" and "AMENT_PREFIX_PATH" in os.environ
+    what = ("the platform" + ("" if system_ros else " and ROS 2 Jazzy's rclpy")
+            + (" and the test tools" if dev else ""))
+    size = ("about 330 MB" if not system_ros else "less: rclpy comes from the system") + (
+        ", about 350 MB more for the test tools" if dev else "")
+    print(f"Setting up {VENV}: {what} from PyPI ({size}; a few minutes the first time).",
+          flush=True)
     if not (BIN / "python").exists():
-        print(f"creating {VENV}" + (" (with the system's ROS 2 Jazzy)" if system_ros else ""),
-              flush=True)
+        print(f"[1/3] creating the virtual environment {VENV}"
+              + (" (with the system's ROS 2 Jazzy)" if system_ros else ""), flush=True)
         try:
             if Path(PYTHON).resolve() == Path(sys.executable).resolve():
                 venv.create(VENV, with_pip=True, system_site_packages=system_ros)
@@ -71,27 +111,51 @@ def setup() -> None:
         except subprocess.CalledProcessError:
             sys.exit("Could not create a virtual environment: on Debian or Ubuntu install "
                      "python3-venv first (apt-get install python3-venv).")
-    pip = [str(BIN / "python"), "-m", "pip", "install", "--disable-pip-version-check", "-q"]
-    subprocess.run([*pip, "--upgrade", "pip"], check=True)
+    pip = [str(BIN / "python"), "-m", "pip", "install", "--disable-pip-version-check"]
+    # pip's own progress in a terminal; a log (CI, a pipe) gets only the steps.
+    quiet = [] if sys.stdout.isatty() else ["-q"]
+    print("[2/3] updating pip", flush=True)
+    subprocess.run([*pip, "-q", "--upgrade", "pip"], check=True)
+    print(f"[3/3] installing {what}", flush=True)
+    target = f"{ROOT}[dev]" if dev else str(ROOT)
     if system_ros:
-        subprocess.run([*pip, *NON_ROS_DEPENDENCIES], check=True)
-        subprocess.run([*pip, "--no-deps", "-e", f"{ROOT}[dev]"], check=True)
+        wanted = [d for d in NON_ROS_DEPENDENCIES if dev or not d.startswith(DEV_ONLY)]
+        subprocess.run([*pip, *quiet, *wanted], check=True)
+        subprocess.run([*pip, *quiet, "--no-deps", "-e", target], check=True)
     else:
-        subprocess.run([*pip, "-e", f"{ROOT}[dev]"], check=True)
-    STAMP.write_text(str(ROOT))
+        subprocess.run([*pip, *quiet, "-e", target], check=True)
+    STAMP.write_text(str(ROOT) + ("\ndev" if dev else ""))
+    minutes, seconds = divmod(round(time.monotonic() - started), 60)
+    print(f"Set up in {minutes} min {seconds} s: {VENV} holds {_size_mb(VENV)} MB.", flush=True)
+    return True
+
+
+def next_steps() -> str:
+    """What to type after the first set-up: the venv on PATH, then the student's commands."""
+    guide = "docs/students/quickstart.md" if (ROOT / "docs").is_dir() else "README.md"
+    activate = os.path.relpath(BIN / "activate") if VENV == ROOT / ".venv" else BIN / "activate"
+    return (f"\nNext, in this terminal and in every new one, put `autograder` on your PATH:\n"
+            f"    . {activate}\n"
+            f"then:\n"
+            f"    autograder list\n"
+            f"    autograder start parameter_validation mywork\n"
+            f"    autograder check parameter_validation mywork/velocity_governor.py\n"
+            f"The student quickstart: {guide}\n")
 
 
 def main(argv: list[str]) -> int:
     if len(argv) < 1 or argv[0] not in JOBS:
         print(__doc__)
         return 2
-    setup()
+    first = setup(argv[0])
     env = dict(os.environ, PATH=f"{BIN}{os.pathsep}{os.environ.get('PATH', '')}",
                VIRTUAL_ENV=str(VENV))
     for command in JOBS[argv[0]]:
         status = subprocess.run([*command, *argv[1:]], cwd=ROOT, env=env).returncode
         if status != 0:
             return status
+    if first:
+        print(next_steps(), end="", flush=True)
     return 0
 
 

@@ -3,6 +3,8 @@
 import re
 from pathlib import Path
 
+import pytest
+
 import tasks
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -41,3 +43,51 @@ def test_make_and_readme_name_only_jobs_of_tasks_py():
     assert "# set up .venv, run the tests" in opening.splitlines()[1]
     for job in re.findall(r"tasks\.py ([\w-]+)", readme):
         assert job in tasks.JOBS, job
+
+
+def test_dev_only_is_the_dev_extra():
+    text = (ROOT / "pyproject.toml").read_text()
+    dev_block = text.split("dev = [", 1)[1].split("]\n", 1)[0]
+    names = {re.split(r"[<>=\[]", d)[0] for d in re.findall(r'^\s*"([^"]+)"', dev_block, re.M)}
+    assert names == set(tasks.DEV_ONLY)
+
+
+@pytest.mark.parametrize("system_ros", [False, True], ids=["pypi-ros", "system-ros"])
+def test_the_demo_installs_no_test_tools_and_says_what_next(monkeypatch, tmp_path, capsys,
+                                                            system_ros):
+    """The demo, a student's first command, installs the platform without the dev extra
+    and ends with the next commands; a test job adds the dev extra once; nothing installs
+    twice."""
+    venv = tmp_path / "venv"
+    (venv / "bin").mkdir(parents=True)
+    (venv / "bin" / "python").touch()
+    monkeypatch.setattr(tasks, "VENV", venv)
+    monkeypatch.setattr(tasks, "BIN", venv / "bin")
+    monkeypatch.setattr(tasks, "STAMP", venv / ".installed")
+    if system_ros:
+        monkeypatch.setenv("ROS_DISTRO", "jazzy")
+        monkeypatch.setenv("AMENT_PREFIX_PATH", "/opt/ros/jazzy")
+    else:
+        monkeypatch.delenv("ROS_DISTRO", raising=False)
+    calls: list[list[str]] = []
+
+    class Done:
+        returncode = 0
+
+    def run(argv, **_kw):
+        calls.append([str(a) for a in argv])
+        return Done()
+
+    monkeypatch.setattr(tasks.subprocess, "run", run)
+    assert tasks.main(["demo"]) == 0
+    installs = [" ".join(c) for c in calls if "install" in c]
+    assert installs and not any("[dev]" in c for c in installs)
+    assert not any(name in c for c in installs for name in tasks.DEV_ONLY)
+    out = capsys.readouterr().out
+    assert "[3/3] installing" in out and "MB" in out
+    assert f". {venv / 'bin' / 'activate'}" in out and "autograder list" in out
+    calls.clear()
+    assert tasks.setup("demo") is False and not calls
+    assert tasks.setup("test") is True
+    assert any(c[-1].endswith("[dev]") for c in calls)
+    assert tasks.setup("demo") is False and tasks.setup("test-all") is False

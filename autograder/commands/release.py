@@ -35,7 +35,8 @@ def _copy(source: Path, dest: Path) -> None:
 
 def _copy_platform(root: Path, out: Path) -> None:
     for name in PLATFORM:
-        _copy(root / name, out / name)
+        if name != "README.md":  # the instructors'; the release gets a student README
+            _copy(root / name, out / name)
     for catalog in sorted((out / "locales").rglob("*.po*")):
         _drop_hidden_entries(catalog)
 
@@ -55,7 +56,9 @@ def _drop_hidden_entries(path: Path) -> None:
         elif message.id:  # shared with public tests: keep it, not the hidden file's name
             message.locations = [loc for loc in message.locations if not hidden(loc)]
     with path.open("wb") as fh:
-        write_po(fh, catalog, width=88, sort_by_file=True)
+        # In the catalog's own order: a hand-appended entry may name a file with no line,
+        # which sorting by file cannot compare.
+        write_po(fh, catalog, width=88)
 
 
 def student_files(exercise: Exercise) -> list[Path]:
@@ -83,7 +86,9 @@ def build_release(out: Path, exercises: list[Exercise] | None = None) -> Path:
         for path in student_files(exercise):
             _copy(path, out / "assignments" / exercise.id / path.relative_to(exercise.folder))
     pages = out / "quizzes-rendered"
-    for quiz_file in load_all():
+    quizzes = load_all()
+    _write_student_readmes(out, exercises or list_exercises(), [qf.quiz for qf in quizzes])
+    for quiz_file in quizzes:
         quiz = quiz_file.quiz
         for lang in quiz.languages:
             pages.mkdir(parents=True, exist_ok=True)
@@ -92,6 +97,31 @@ def build_release(out: Path, exercises: list[Exercise] | None = None) -> Path:
             (pages / f"{quiz.id}.{lang}.mdx").write_text(render_markdown(quiz, lang),
                                                          encoding="utf-8")
     return out
+
+
+def _write_student_readmes(out: Path, exercises: list[Exercise], quizzes: list) -> None:
+    """README.md and README.ur.md: commands that work inside the release (set up, start,
+    check; the quizzes as the pages it holds), none of which needs a solution or a key."""
+    import jinja2
+
+    from autograder.quiz.localize import Localizer
+
+    content = translations("ur", "content")
+    ordered = sorted(exercises, key=lambda e: (e.id != "parameter_validation", e.id))
+    rows = [{"id": e.id, "file": e.file, "title": e.title,
+             "title_ur": content.pgettext(f"exercise:{e.id}:title", e.title)}
+            for e in sorted(exercises, key=lambda e: e.id)]
+    quiz_rows = [{"id": q.id, "title": q.title, "ur": "ur" in q.languages,
+                  "title_ur": Localizer(q, "ur").quiz_text("title").value}
+                 for q in sorted(quizzes, key=lambda q: q.id)]
+    env = jinja2.Environment(loader=jinja2.PackageLoader("autograder", "templates"),
+                             autoescape=False, keep_trailing_newline=True,
+                             undefined=jinja2.StrictUndefined)
+    values = {"title": "rclpy exercises", "first": ordered[0], "exercises": rows,
+              "quizzes": quiz_rows}
+    for name in ("README.md", "README.ur.md"):
+        text = env.get_template(f"release-{name}").render(**values)
+        (out / name).write_text(text, encoding="utf-8")
 
 
 SETUP_SH = """#!/usr/bin/env bash
