@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import threading
 import urllib.error
 import urllib.parse
@@ -50,7 +51,8 @@ def test_binds_loopback_on_a_free_port(server: QuizServer) -> None:
 
 def test_urdu_page_and_submit(server: QuizServer) -> None:
     page = _get(server.url + "quiz/rclpy-part2/?lang=ur")
-    assert '<html lang="ur" dir="rtl">' in page and 'action="submit"' in page
+    assert '<html lang="ur" dir="rtl">' in page
+    assert 'action="/quiz/rclpy-part2/submit"' in page
     assert "cpython-lock" in page  # option ids are there, which one is right is not
     fields = [("lang", "ur"), ("seed", "3"), ("q:callback-groups-purpose", "concurrency"),
               ("q:declare-parameters", "declare"), ("q:gil", "cpython-lock"),
@@ -104,3 +106,42 @@ def test_the_result_page_shows_the_students_own_answer(server: QuizServer, lang:
     assert f'<p class="answer">{said}</p>' in section("calls-in-two-seconds")
     assert section("keep-in-step").count("<code") == 2  # both options, their code as code
     assert 'class="answer"' not in section("period-units")
+
+
+@pytest.mark.parametrize("path", ["quiz/rclpy-part2?lang=en", "quiz/rclpy-part2/?lang=en",
+                                  "quiz/rclpy-part2"])
+def test_the_form_posts_to_its_quiz_from_any_url_form(server: QuizServer, path: str) -> None:
+    """A browser resolves the form's action against the page's own URL: with or without
+    the trailing slash, it is the quiz's submit."""
+    url = server.url + path
+    action = re.search(r'<form id="quiz" method="post" action="([^"]+)"', _get(url))
+    assert action
+    status, page = _post(urllib.parse.urljoin(url, action.group(1)),
+                         [("lang", "en"), ("q:gil", "cpython-lock")])
+    assert status == 200 and 'id="verdict"' in page
+
+
+UNREADABLE = {"en": ("“five” is not a number", "Two items have the same place, 1",
+                     "Some answers could not be read"),
+              "ur": ("کوئی عدد نہیں", "دو چیزوں کا مقام ایک ہی ہے",
+                     "کچھ جوابات پڑھے نہیں جا سکے")}
+
+
+@pytest.mark.parametrize("lang", ["en", "ur"])
+def test_unreadable_answers_come_back_with_a_message_and_the_rest_kept(
+        server: QuizServer, lang: str) -> None:
+    number, places, summary = UNREADABLE[lang]
+    fields = [("lang", lang), ("seed", "3"), ("q:calls-in-two-seconds", "five"),
+              ("q:period-units", "seconds")]
+    status, page = _post(server.url + "quiz/timer-synchronization/submit", fields)
+    assert status == 400 and summary in page and 'id="verdict"' not in page
+    problem = page.split('id="q-calls-in-two-seconds-problem"')[1].split("</p>")[0]
+    assert number in problem and "five" in problem
+    assert 'value="five"' in page  # what was typed is there to correct
+    assert re.search(r'name="q:period-units" value="seconds" checked', page)
+    order = [("lang", lang), ("q:life-order:init", "1"), ("q:life-order:create", "1"),
+             ("q:life-order:spin", "3")]
+    status, page = _post(server.url + "quiz/error-handling/submit", order)
+    assert status == 400
+    assert places in page.split('id="q-life-order-problem"')[1].split("</p>")[0]
+    assert re.search(r'name="q:life-order:spin".*?<option value="3" selected>', page)

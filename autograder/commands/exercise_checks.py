@@ -116,7 +116,7 @@ def _hand_run(exercise: Exercise, path: Path, lines: list[str],
         world, node = match.groups()
         if node != f"mydir/{exercise.file}" or world not in worlds:
             problems.append(Problem(path, line, _(
-                "the hand run names {world} and {node}: it runs mydir/{file} in a world the "
+                "the hand run names {world} and {node}: it runs `mydir/{file}` in a world the "
                 "exercise is graded in ({worlds})").format(
                 world=world, node=node, file=exercise.file,
                 worlds=", ".join(sorted(worlds)))))
@@ -188,8 +188,8 @@ def _proof(exercise: Exercise, root: Path) -> list[Problem]:
     if not module.exists() or f'PROOF = Proof("{exercise.id}"' not in module.read_text(
             encoding="utf-8"):
         problems.append(Problem(module, None, _(
-            "no proof: this module declares PROOF = Proof({id!r}) (autograder new exercise "
-            "writes one)").format(id=exercise.id)))
+            "no proof: this module declares `PROOF = Proof({id!r})` (`autograder new "
+            "exercise` writes one)").format(id=exercise.id)))
     folder = root / "tests" / "submissions" / exercise.id
     lost: set[str] = set()
     for expect in sorted(folder.glob("*/expect.yaml")):
@@ -201,8 +201,8 @@ def _proof(exercise: Exercise, root: Path) -> list[Problem]:
             lost |= set(data.get("loses") or ())
     if not lost:
         problems.append(Problem(folder, None, _(
-            "no known-bad submission: a folder here with expect.yaml (kind: mutant, loses: "
-            "[...]) and a patch of the solution")))
+            "no known-bad submission: a folder here with `expect.yaml` (`kind: mutant`, "
+            "`loses: [...]`) and a patch of the solution")))
     for name in exercise.core:
         if lost and name not in lost:
             problems.append(Problem(folder, None, _(

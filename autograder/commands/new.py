@@ -119,7 +119,7 @@ def new_exercise(exercise_id: str, root: Path | None = None) -> Scaffold:
     folder = root / "assignments" / exercise_id
     if not EXERCISE_ID.match(exercise_id):
         raise ContentError(folder, _(
-            "an exercise id is lower-case letters, digits and '_', starting with a letter "
+            "an exercise id is lower-case letters, digits and `_`, starting with a letter "
             "(it names the folder, the file and the node): {id!r}").format(id=exercise_id))
     if folder.exists():
         raise ContentError(folder, _("already exists: pick another id"))
@@ -155,10 +155,10 @@ def new_exercise(exercise_id: str, root: Path | None = None) -> Scaffold:
                "and the grading table (one row per test).").format(
         readme=folder / "README.md", urdu=folder / "README.ur.md"),
         _("Write the reference solution {solution}, then the starter {starter} from it, "
-          "with TODO comments where the student's work goes.").format(
+          "with `TODO` comments where the student's work goes.").format(
         solution=folder / "solution" / file, starter=folder / "starter" / file),
-        _("Write the tests in {tests}: a docstring label, @pytest.mark.points and a "
-          "StudentFailure with a hint for each; name the core tests in exercise.yaml.").format(
+        _("Write the tests in {tests}: a docstring label, `@pytest.mark.points` and a "
+          "`StudentFailure` with a hint for each; name the core tests in `exercise.yaml`.").format(
         tests=folder / "tests")]
     proofs = root / "tests"
     if proofs.is_dir():
@@ -175,11 +175,11 @@ def new_exercise(exercise_id: str, root: Path | None = None) -> Scaffold:
         _write(proofs / f"test_grading_{exercise_id}.py", _fill(_template(
             "exercise", "test_grading.py.tmpl"), values), written)
         steps.append(_("Prove the tests: a folder in {submissions} for each known-bad "
-                       "variant (expect.yaml and a patch: python tests/proving.py patch "
-                       "FOLDER), then python -m pytest {proof}.").format(
+                       "variant (`expect.yaml` and a patch: `python tests/proving.py patch "
+                       "FOLDER`), then `python -m pytest {proof}`.").format(
             submissions=variant.parent, proof=proofs / f"test_grading_{exercise_id}.py"))
-    steps.append(_("Check it all: autograder validate (the Urdu of a changed title or label "
-                   "goes in locales/ur/LC_MESSAGES/)."))
+    steps.append(_("Check it all: `autograder validate` (the Urdu of a changed title or "
+                   "label goes in `locales/ur/LC_MESSAGES/`)."))
     return Scaffold(tuple(written), tuple(steps))
 
 
@@ -191,7 +191,7 @@ def new_quiz(quiz_id: str, root: Path | None = None) -> Scaffold:
     path = root / "quizzes" / f"{quiz_id}.yaml"
     if not QUIZ_ID.match(quiz_id):
         raise ContentError(path, _(
-            "a quiz id is lower-case letters, digits and '-', starting with a letter: "
+            "a quiz id is lower-case letters, digits and `-`, starting with a letter: "
             "{id!r}").format(id=quiz_id))
     if path.exists() or (root / "quizzes" / f"{quiz_id}.yml").exists():
         raise ContentError(path, _("already exists: pick another id"))
@@ -206,6 +206,6 @@ def new_quiz(quiz_id: str, root: Path | None = None) -> Scaffold:
                              for s in strings(quiz)], written)
     steps = (_("Write your questions in {path}: edit or delete the examples (each type is "
                "there once), keeping each id unique.").format(path=path),
-             _("Translate each changed string in locales/ur/LC_MESSAGES/content.po, then "
-               "check it all: autograder validate."))
+             _("Translate each changed string in `locales/ur/LC_MESSAGES/content.po`, then "
+               "check it all: `autograder validate`."))
     return Scaffold(tuple(written), steps)

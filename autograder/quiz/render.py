@@ -72,13 +72,18 @@ def _page_context(quiz: Quiz, lang: str) -> dict[str, Any]:
 
 
 def render_page(quiz: Quiz, lang: str, seed: str | int | None = None,
-                action: str | None = None, languages: tuple[str, ...] = ()) -> str:
-    """The quiz page; with ``action`` the form posts there, else answers save to a file."""
+                action: str | None = None, languages: tuple[str, ...] = (),
+                given: Mapping[str, list[str]] | None = None,
+                problems: Mapping[str, str] | None = None) -> str:
+    """The quiz page; with ``action`` the form posts there, else answers save to a file.
+    ``given`` (a submitted form) fills the answers back in; ``problems`` says at each
+    question id why what was entered is no answer."""
     with using_language(lang):
         return _ENV.get_template("quiz.html").render(
             **_page_context(quiz, lang), questions=question_views(quiz, lang, seed),
             seed="" if seed is None else str(seed), action=action,
-            languages=languages or quiz.languages)
+            languages=languages or quiz.languages, given=given or {},
+            problems=problems or {})
 
 
 def render_result(quiz: Quiz, result: RunResult, answers: Mapping[str, Any],

@@ -37,6 +37,10 @@ def form_answers(quiz: Quiz, form: Mapping[str, list[str]]) -> dict[str, Any]:
     return answers
 
 
+def _submit_url(quiz: Quiz) -> str:
+    return f"/quiz/{quiz.id}/submit"
+
+
 class QuizServer(HTTPServer):
     """An HTTP server that knows the course's quizzes."""
 
@@ -92,9 +96,11 @@ class _Handler(BaseHTTPRequestHandler):
                 if self.path.split("?")[0] == "/":
                     quizzes = list(self.server.quizzes.values())
                     self._send(HTTPStatus.OK, render_index(quizzes, lang, LANGUAGES))
-                elif quiz is not None and rest == "":
+                elif quiz is not None and rest in ("", "submit"):  # submit: a reload
                     seed = secrets.randbelow(10**9)  # a fresh option order per attempt
-                    self._send(HTTPStatus.OK, render_page(quiz, lang, seed, action="submit"))
+                    # Absolute: /quiz/ID and /quiz/ID/ both post to /quiz/ID/submit.
+                    self._send(HTTPStatus.OK, render_page(quiz, lang, seed,
+                                                          action=_submit_url(quiz)))
                 else:
                     self._error(HTTPStatus.NOT_FOUND, _("Not found."), lang)
             except Exception:  # our bug, not the student's: say so, keep serving
@@ -112,6 +118,12 @@ class _Handler(BaseHTTPRequestHandler):
                 self._error(HTTPStatus.NOT_FOUND, _("Not found."), lang)
                 return
             seed = form.get("seed", [""])[0] or None
+            problems = {q.id: problem for q in quiz.questions
+                        if (problem := question_type(q.type).form_problem(q, form))}
+            if problems:  # the page again, the answers kept, each problem at its question
+                self._send(HTTPStatus.BAD_REQUEST, render_page(
+                    quiz, lang, seed, action=_submit_url(quiz), given=form, problems=problems))
+                return
             try:
                 answers = check_answers("<form>", quiz, {"quiz": quiz.id,
                                                          "answers": form_answers(quiz, form)})

@@ -180,6 +180,11 @@ class QuestionType(abc.ABC):
     def parse_form(self, q: Question, form: Form) -> Any | None:
         """The answer in a submitted form, in the answers-file shape; None if left blank."""
 
+    def form_problem(self, q: Question, form: Form) -> str | None:
+        """Why what was entered for ``q`` is no answer (``five`` in a number box), for the
+        page to say so at the question; None when it reads, or was left blank."""
+        return None
+
     # The Markdown export ----------------------------------------------------------------
 
     @abc.abstractmethod

@@ -84,6 +84,13 @@ class Numeric(QuestionType):
         except ValueError:
             return None  # not a number: scored as not answered, as a blank box is
 
+    def form_problem(self, q: Question, form: Form) -> str | None:
+        value = (first_value(q, form) or "").strip()
+        if value and self.parse_form(q, form) is None:
+            return _("“{value}” is not a number: write it in digits, such as 8 or 0.25.").format(
+                value=value)
+        return None
+
     def markdown_lines(self, view: QuestionView) -> list[str]:
         unit = f" {markdown_inline(view.unit)}" if view.unit else ""
         return [f"{_('Answer:')} \\_\\_\\_\\_\\_\\_{unit}", ""]

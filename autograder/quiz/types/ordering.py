@@ -79,6 +79,17 @@ class Ordering(QuestionType):
             return None
         return [oid for _place, _i, oid in sorted(places)]
 
+    def form_problem(self, q: Question, form: Form) -> str | None:
+        places = [form.get(f"q:{q.id}:{o.id}", [""])[0] for o in q.options]
+        given = [p for p in places if p]
+        twice = sorted({p for p in given if given.count(p) > 1}, key=lambda p: (len(p), p))
+        if twice:
+            return _("Two items have the same place, {place}: give each item a place of its "
+                     "own.").format(place=twice[0])
+        if given and len(given) != len(places):
+            return _("Give every item its place (or none, to leave the question out).")
+        return None
+
     def markdown_lines(self, view: QuestionView) -> list[str]:
         return [_("Put these in order:"), "",
                 *(f"- [ ] {markdown_inline(o.text)}" for o in view.options), ""]
