@@ -251,3 +251,19 @@ def test_a_programs_output_in_a_message_stays_left_to_right_line_by_line() -> No
 def test_a_chain_of_calls_is_one_latin_run() -> None:
     html = str(rich(ur("یاد رکھیں کہ آخری scan کب آیا (self.get_clock().now()) میں")))
     assert '<bdi lang="en" dir="ltr">self.get_clock().now()</bdi>' in html
+
+
+def test_code_is_one_isolate_in_the_terminal_too() -> None:
+    line = for_terminal("جو reading شرط `range_min <= r <= range_max` پوری نہ کرے؛ cmd_vel پر "
+                        "linear.x=0.2, angular.z=0 آیا", "ur")
+    assert f"{LRI}`range_min <= r <= range_max`{PDI}" in line
+    assert f"{LRI}linear.x=0.2, angular.z=0{PDI}" in line
+    assert for_terminal("[INFO] a, b", "ur") == "[INFO] a, b"  # a program's own line
+
+
+def test_an_expression_is_one_run_in_html() -> None:
+    html = str(rich(ur("جو شرط range_min <= r <= range_max پوری نہ کرے، (goal_x, goal_y) "
+                       "سے دور اور [-pi, pi] میں")))
+    assert '<bdi lang="en" dir="ltr">range_min &lt;= r &lt;= range_max</bdi>' in html
+    assert '(<bdi lang="en" dir="ltr">goal_x, goal_y</bdi>)' in html  # the pair mirrors
+    assert '[<bdi lang="en" dir="ltr">-pi, pi</bdi>]' in html
