@@ -20,8 +20,9 @@ _PLACEHOLDER = re.compile(r"\{\{|\}\}|\{[^{}]*\}|%\(\w+\)[sdrf]")
 # In right-to-left text, Latin pieces separated by operators, brackets or commas are laid
 # out as separate left-to-right runs in right-to-left order: "range_min <= r <= range_max"
 # reads "range_max => r => range_min".  Code is written `as one span`.
-_TOKEN = r"(?:[A-Za-z_][\w.]*|\d[\w.]*|\{[A-Za-z_]\w*\})"
-_OPERAND = r"(?:[A-Za-z]\w*_[\w.]*|[a-z]{1,2}|\d[\d.]*|\{[A-Za-z_]\w*\})"
+_FIELD = r"\{[A-Za-z_]\w*(?:![rsa])?(?::[^{}]*)?\}"
+_TOKEN = rf"(?:[A-Za-z_][\w.]*|\d[\w.]*|{_FIELD})"
+_OPERAND = rf"(?:[A-Za-z]\w*_[\w.]*|[a-z]{{1,2}}|\d[\d.]*|{_FIELD})"
 _CODE_SHAPES = (
     # an operator between two operands: "r <= range_max", "angle_max - angle_min"
     re.compile(rf"{_TOKEN}[)\]]* (?:<=|>=|==|!=|<|>|\+|-|\*|/|//|%) [(\[-]*{_TOKEN}"),

@@ -136,7 +136,7 @@ def judge_reached(mission: Mission, credit: Any, world_name: str) -> None:
     progress = mission.progress()
     if mission.hit is not None:
         hit = mission.hit
-        message = _("In the {world}, the robot hit {what} at ({x:.2f}, {y:.2f}) after "
+        message = _("In the {world}, the robot hit {what} at `({x:.2f}, {y:.2f})` after "
                     "{seconds:.1f} s, having covered {share:.0%} of the way to the goal.").format(
             world=world_name, what=hit.hit_name, x=hit.x, y=hit.y,
             seconds=hit.t - mission.t0, share=progress)

@@ -168,7 +168,7 @@ def test_never_collides(run, world, student):
         first = collisions[0]
         raise StudentFailure(
             with_front_beam_note(
-                _("The robot hit {what} at ({x:.2f}, {y:.2f}), {seconds:.1f} s into the run.")
+                _("The robot hit {what} at `({x:.2f}, {y:.2f})`, {seconds:.1f} s into the run.")
                 .format(what=first.hit_name, x=first.x, y=first.y,
                         seconds=first.t - run.start),
                 collisions, samples, world.world.geometry),
