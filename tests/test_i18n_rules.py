@@ -205,7 +205,9 @@ def test_what_a_robot_hits_is_named_in_the_oblique(real: Glossary) -> None:
     translations.cache_clear()
     set_language("ur")
     try:
-        template = _("The robot hit {what} at ({x:.2f}, {y:.2f}), {seconds:.1f} s into the run.")
+        # the message test_faulty_world gives, as the catalog translates it
+        template = _("The robot hit {what} at `({x:.2f}, {y:.2f})`, {seconds:.1f} s into the "
+                     "run.")
         said = [(template.format(what=contact.hit_name, x=0.5, y=0.5, seconds=1.0),
                  template.format(what=contact.description, x=0.5, y=0.5, seconds=1.0))
                 for contact in (Contact(t=1.0, x=0.5, y=0.5, what=what)
