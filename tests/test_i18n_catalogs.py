@@ -94,7 +94,8 @@ def test_extract_update_compile_check(course: Path) -> None:
     with (locales / "messages.pot").open("rb") as fh:
         platform = {m.id: m for m in read_po(fh) if m.id}
     assert set(platform) == {"Lazy label", "{path} not found", "Submit answers"}
-    assert ("autograder/mod.py", 4) in platform["{path} not found"].locations
+    # The platform's locations name the file only: an edit elsewhere moves no entry.
+    assert platform["{path} not found"].locations == [("autograder/mod.py", None)]
     with (locales / "content.pot").open("rb") as fh:
         content = {m.context for m in read_po(fh) if m.id}
     assert "exercise:timers:title" in content and "quiz:rclpy-part2:gil:text" in content
@@ -161,3 +162,27 @@ def test_babel_accepts_our_extractor_by_module_path() -> None:
                             io.BytesIO(source.read_bytes())))
     lineno, message, _comments, context = messages[0]
     assert (lineno, context, message) == (3, "quiz:rclpy-part2:title", ALL_TITLE)
+
+
+def test_extracting_after_a_content_change_touches_only_what_changed(course: Path) -> None:
+    """Adding a quiz (and lines above a platform string) leaves the platform's template
+    and catalogs byte for byte as they were; the content template gains the quiz only."""
+    locales = course / "locales"
+    assert _run("extract")[0] == 0 and _run("update")[0] == 0
+    platform = [locales / "messages.pot", locales / "ur" / "LC_MESSAGES" / "messages.po"]
+    before = [p.read_bytes() for p in platform]
+    content = (locales / "content.pot").read_text()
+    mod = course / "autograder" / "mod.py"
+    mod.write_text("# a comment that moves every line below it\n" + mod.read_text())
+    (course / "quizzes" / "extra.yaml").write_text(
+        "id: extra\ntitle: Extra\nquestions:\n  - id: sure\n    type: true_false\n"
+        "    text: Yes?\n    answer: true\n")
+    assert _run("extract")[0] == 0 and _run("update")[0] == 0
+    assert [p.read_bytes() for p in platform] == before
+    after = (locales / "content.pot").read_text().splitlines()
+    added, removed = set(after) - set(content.splitlines()), set(content.splitlines()) - set(after)
+    assert {line for line in added if line.startswith("msgctxt")} == {
+        'msgctxt "quiz:extra:title"', 'msgctxt "quiz:extra:sure:text"'}
+    assert not [line for line in added if line.startswith("#: quizzes/part2")]
+    assert [line for line in removed if not line.startswith('"POT-Creation-Date')] == []
+

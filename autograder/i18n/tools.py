@@ -89,10 +89,27 @@ def extract(root: Path, locales: Path, cfg: Path | None = None) -> list[Path]:
         catalog = _collect(root, method_map, options_map, domain)
         out = locales / f"{domain}.pot"
         out.parent.mkdir(parents=True, exist_ok=True)
-        with out.open("wb") as fh:
-            write_po(fh, catalog, width=88, sort_by_file=True, omit_header=False)
+        buffer = io.BytesIO()
+        write_po(buffer, catalog, width=88, sort_by_file=True, omit_header=False,
+                 include_lineno=_with_lines(domain))
+        if not out.exists() or _stamp_free(out.read_bytes()) != _stamp_free(buffer.getvalue()):
+            out.write_bytes(buffer.getvalue())  # unchanged: its date and the .po files stay
         written.append(out)
     return written
+
+
+def _with_lines(domain: str) -> bool:
+    """Line numbers in locations: for course content (a quiz's own lines move only when it
+    changes), not for the platform, whose every edit would move other strings' lines and
+    rewrite entries whose text did not change: file-only locations keep those still."""
+    return domain != PLATFORM_DOMAIN
+
+
+_STAMP = re.compile(rb'^"POT-Creation-Date: [^"]*"\n', re.M)
+
+
+def _stamp_free(text: bytes) -> bytes:
+    return _STAMP.sub(b"", text)
 
 
 def read_catalog(path: Path, locale: str | None = None) -> Catalog:
@@ -112,7 +129,8 @@ def read_catalog(path: Path, locale: str | None = None) -> Catalog:
 
 def _write(path: Path, catalog: Catalog) -> None:
     buffer = io.BytesIO()
-    write_po(buffer, catalog, width=88, sort_by_file=True)
+    write_po(buffer, catalog, width=88, sort_by_file=True,
+             include_lineno=_with_lines(catalog.domain or path.stem))
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_bytes(buffer.getvalue())
 
