@@ -67,3 +67,10 @@ def test_the_readme_checks_a_starter_as_pasted(release: Path, terminal: Terminal
     assert "mywork/velocity_governor.py" in out
     if name == "README.ur.md":
         assert (terminal.folder / "report.html").is_file()
+
+
+def test_the_urdu_readme_follows_the_glossary(release: Path) -> None:
+    from autograder.i18n.glossary import load_glossary
+
+    glossary = load_glossary(release / "locales" / "ur" / "glossary.yaml")
+    assert [str(p) for p in glossary.check_readme(release / "README.ur.md")] == []
