@@ -1,10 +1,11 @@
 """Every exercise's reference keeps full marks in isolation by user (root without
-namespaces: Gradescope's container, a pod), as it does in strict isolation, and its
-grade is official (issue 29)."""
+namespaces: Gradescope's container, a pod) and in basic isolation, as it does in strict
+isolation; only isolation by user's grade is official (issue 29)."""
 
 from __future__ import annotations
 
 import os
+from collections.abc import Iterator
 from concurrent.futures import ThreadPoolExecutor
 
 import pytest
@@ -20,13 +21,13 @@ pytestmark = [pytest.mark.slow,
               pytest.mark.skipif(os.geteuid() != 0, reason="isolation by user needs root")]
 
 
-@pytest.fixture(scope="module", autouse=True)
-def by_user():
+@pytest.fixture(scope="module", params=["user", "basic"])
+def mode(request: pytest.FixtureRequest) -> Iterator[str]:
     old = os.environ.get("AUTOGRADER_ISOLATION")
-    os.environ["AUTOGRADER_ISOLATION"] = "user"
+    os.environ["AUTOGRADER_ISOLATION"] = request.param
     isolation.detect.cache_clear()
     with modes_kept(isolation.protected_paths(course_root())):
-        yield
+        yield request.param
     if old is None:
         os.environ.pop("AUTOGRADER_ISOLATION", None)
     else:
@@ -35,17 +36,17 @@ def by_user():
 
 
 @pytest.fixture(scope="module")
-def graded() -> dict[str, RunResult]:
-    """Every reference graded in isolation by user, two at a time (as the corpus is)."""
+def graded(mode: str) -> dict[str, RunResult]:
+    """Every reference graded in ``mode``, two at a time (as the corpus is)."""
     with ThreadPoolExecutor(max_workers=2) as pool:
         return dict(pool.map(lambda e: (e.id, grade(e, None)), list_exercises()))
 
 
 @pytest.mark.parametrize("exercise", list_exercises(), ids=lambda e: e.id)
-def test_the_reference_keeps_full_marks(exercise, graded):
+def test_the_reference_keeps_full_marks(exercise, graded, mode):
     result = graded[exercise.id]
-    assert result.data["isolation"]["mode"] == "user"
-    assert result.data["isolation"]["official"] is True
+    assert result.data["isolation"]["mode"] == mode
+    assert result.data["isolation"]["official"] is (mode == "user")
     assert result.grader_error is None, result.grader_details
     assert result.score == result.max_score, [(t.name, t.message) for t in result.tests
                                               if not t.passed]

@@ -225,6 +225,8 @@ class RunResult:
             # `--record DIR`: each test module's rosbag2 bag, and what kept one from being made.
             **({"bags": self.data["bags"]} if self.data.get("bags") else {}),
             **({"warnings": self.data["warnings"]} if self.data.get("warnings") else {}),
+            # Whose programs disturbed the gradings done again before this one (issue 29).
+            **({"disturbed": self.data["disturbed"]} if self.data.get("disturbed") else {}),
             # Where the wall seconds and the memory went (autograder/plugin/timing.py).
             **({"timing": self.data["timing"]} if self.data.get("timing") else {}),
             **({"memory": self.data["memory"]} if self.data.get("memory") else {}),

@@ -28,6 +28,7 @@ from fractions import Fraction
 
 import pytest
 
+from autograder.core.dumpable import not_dumpable
 from autograder.core.errors import GraderError
 from autograder.core.settings import RunSettings
 from autograder.i18n import set_language
@@ -99,7 +100,7 @@ def pytest_configure(config: pytest.Config) -> None:
     set_language(settings.lang)
     if settings.course:
         os.environ["AUTOGRADER_COURSE"] = settings.course
-    _not_dumpable()  # before the key is read: no process of our user may read our memory
+    not_dumpable()  # before the key is read: no process of our user may read our memory
     key = b""
     if settings.key_fd is not None:  # a pipe from the parent: the student never sees it
         with os.fdopen(settings.key_fd, "rb") as pipe:
@@ -109,16 +110,6 @@ def pytest_configure(config: pytest.Config) -> None:
     config.pluginmanager.register(reporter, "autograder-reporter")
     if settings.lifeline_fd is not None:
         _watch_lifeline(settings.lifeline_fd, reporter)
-
-
-def _not_dumpable() -> None:
-    """``PR_SET_DUMPABLE`` 0: in basic isolation the student runs as our user, and could
-    otherwise trace this process or read its memory (``/proc/PID/mem``), the report's key
-    with it. Programs we exec are dumpable again; only this process is closed."""
-    import ctypes
-
-    pr_set_dumpable = 4
-    ctypes.CDLL(None, use_errno=True).prctl(pr_set_dumpable, 0, 0, 0, 0)
 
 
 def _watch_lifeline(fd: int, reporter: GradingReporter) -> None:
