@@ -65,8 +65,10 @@ def _chosen(specs: list[str], correct: bool) -> list[tuple[str, Variant]]:
     return chosen
 
 
-def _difference(result: RunResult, variant: Variant) -> str | None:
+def _difference(result: RunResult | BaseException, variant: Variant) -> str | None:
     """What differs from the expectation in one grading (None: nothing)."""
+    if isinstance(result, BaseException):
+        return f"the grading crashed: {type(result).__name__}: {result}"
     if result.grader_error is not None:
         return f"grader error: {result.grader_error}"
     lost = {t.name for t in result.tests if t.status != "passed"}
@@ -80,14 +82,14 @@ def _difference(result: RunResult, variant: Variant) -> str | None:
 
 
 def _round(chosen: list[tuple[str, Variant]], workdir: Path,
-           jobs: int) -> list[RunResult]:
+           jobs: int) -> list[RunResult | BaseException]:
     with ThreadPoolExecutor(max_workers=jobs) as pool:
         futures = []
         for exercise_id, variant in chosen:
             exercise = find_exercise(exercise_id)
             folder = variant.submission(exercise, workdir / exercise_id)
             futures.append(pool.submit(grade, exercise, folder))
-        return [f.result() for f in futures]
+        return [f.exception() or f.result() for f in futures]  # a crash is a difference
 
 
 def main(argv: list[str]) -> int:
@@ -117,9 +119,12 @@ def main(argv: list[str]) -> int:
                     if difference is None:
                         exact[key] += 1
                     else:
+                        said = "" if isinstance(result, BaseException) else \
+                            f"score {result.score}/{result.max_score}: "
+                        told = "" if isinstance(result, BaseException) else \
+                            f"\n      said: {failures(result)}"
                         differences.setdefault(key, []).append(
-                            f"round {round_}: score {result.score}/{result.max_score}: "
-                            f"{difference}\n      said: {failures(result)}")
+                            f"round {round_}: {said}{difference}{told}")
                 print(f"round {round_} done, {time.monotonic() - started:.0f} s",
                       flush=True)
     finally:
