@@ -154,8 +154,8 @@ def list_command(as_json: bool) -> None:
         click.echo(json.dumps({
             "exercises": [{"id": e.id, "title": e.title, "file": e.file, "node": e.node,
                            "languages": list(LANGUAGES)} for e in exercises],
-            "quizzes": [{"id": q.id, "title": q.title, "languages": list(q.languages)}
-                        for q in quizzes],
+            "quizzes": [{"id": q.id, "title": q.title, "languages": list(q.languages),
+                         **({"error": q.error} if q.error else {})} for q in quizzes],
         }, ensure_ascii=False, indent=2))
         return
     click.echo(_("Exercises:"))
@@ -164,7 +164,8 @@ def list_command(as_json: bool) -> None:
     if quizzes:
         click.echo(_("Quizzes:"))
         for q in quizzes:
-            click.echo(f"  {q.id:<24} {q.title}")
+            click.echo(f"  {q.id:<24} " + (q.title if not q.error else _(
+                "not loaded: {error}").format(error=q.error)))
 
 
 def _quizzes() -> list:
@@ -471,6 +472,7 @@ def grade_batch(item: str, submissions: Path, jobs: int | str, csv_path: Path, o
     every answers file for a quiz. Resumable: graded students are skipped. Exercises are
     graded only where the grades are official, unless --allow-unofficial."""
     from autograder.commands.batch import parse_shard, run_batch, students
+    from autograder.core.results import number
 
     if _exercise_or_none(item) is not None:
         if not allow_unofficial:
@@ -493,7 +495,9 @@ def grade_batch(item: str, submissions: Path, jobs: int | str, csv_path: Path, o
         if result is None:
             click.echo(_("{student}: already graded").format(student=student), err=True)
         else:
-            click.echo(f"{student}: {result.score}/{result.max_score}", err=True)
+            # Decimals, as the gradebook has them (20/3 points is 6.6667, not "20/3").
+            click.echo(f"{student}: {number(result.score)}/{number(result.max_score)}",
+                       err=True)
 
     if jobs == "auto":
         from autograder.grading.capacity import auto_chooser
@@ -592,6 +596,27 @@ def gradebook_merge(out: Path, inputs: tuple[Path, ...]) -> None:
     gradebook.write(out, rows)
     click.echo(ngettext("{count} row in {path}", "{count} rows in {path}", len(rows)).format(
         count=len(rows), path=out))
+
+
+@gradebook_group.command("export")
+@click.option("--format", "fmt", type=click.Choice(["moodle", "canvas"]), required=True,
+              help="The LMS gradebook layout: one row per student, a column per item.")
+@click.argument("out", type=click.Path(path_type=Path, dir_okay=False))
+@click.argument("inputs", nargs=-1, required=True,
+                type=click.Path(path_type=Path, dir_okay=False, exists=True))
+def gradebook_export(fmt: str, out: Path, inputs: tuple[Path, ...]) -> None:
+    """Write OUT, the gradebooks INPUTS merged, as the CSV Moodle's or Canvas's gradebook
+    imports (students named by their submission's folder: their LMS login)."""
+    from autograder.commands import gradebook
+    from autograder.commands.lms_export import export
+
+    try:
+        rows = gradebook.merge(*(gradebook.read(p) for p in inputs))
+    except ContentError as exc:
+        raise UsageProblem(str(exc)) from None
+    count = export(out, rows, fmt)
+    click.echo(ngettext("{count} student in {path}", "{count} students in {path}",
+                        count).format(count=count, path=out))
 
 
 @main.command()
