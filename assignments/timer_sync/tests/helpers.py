@@ -240,14 +240,18 @@ def blocked_hint(run: Run, gap: float, where: float, status: bool = False) -> st
     during = planner_run_during(run, where, where + gap)
     if during is None:
         return None
+    # The run ended in a plan, so ROS time went on meanwhile: a thread was free for
+    # /clock, and the timer waited for the planner's group, not for a thread.
     if status:
         text = _("The gap fell on a planner run (t={a:.2f} to {b:.2f} s): while plan_route() "
-                 "blocked, the status timer could not run. Give the planner timer a callback "
-                 "group of its own and spin a MultiThreadedExecutor.")
+                 "blocked, the status timer could not run, though ROS time went on (the plan "
+                 "came), so a thread was free: it waited for the planner's callback group. "
+                 "Give the planner timer a callback group of its own.")
     else:
         text = _("The gap fell on a planner run (t={a:.2f} to {b:.2f} s): while plan_route() "
-                 "blocked, the control timer could not run. Give the planner timer a "
-                 "callback group of its own and spin a MultiThreadedExecutor.")
+                 "blocked, the control timer could not run, though ROS time went on (the "
+                 "plan came), so a thread was free: it waited for the planner's callback "
+                 "group. Give the planner timer a callback group of its own.")
     return text.format(a=during[0], b=during[1])
 
 

@@ -104,8 +104,9 @@ def test_control_while_planning(run, evidence):
                 _("While the planner ran (t={a:.2f} to {b:.2f} s of simulation time), cmd_vel "
                   "came {count} times, with a gap of {gap:.2f} s at t={t:.2f}; expected 10 Hz "
                   "throughout.").format(a=began, b=done, count=len(times), gap=gap, t=where),
-                _("Give the planner timer its own callback group and spin a "
-                  "MultiThreadedExecutor, so control runs in another thread meanwhile."))
+                _("The plan came, so ROS time went on and a thread was free, but the control "
+                  "timer waited for the planner: they share a callback group. Give the "
+                  "planner timer a callback group of its own."))
 
 
 @pytest.mark.points(1)
