@@ -15,6 +15,9 @@ from autograder.i18n.cli import i18n_cli
 from autograder.quiz.extract import extract_exercise, extract_quiz
 
 REPO = Path(__file__).resolve().parent.parent
+# The quizzes these tests read: a frozen copy, so that editing quizzes/ never breaks a
+# platform test (tests/fixtures/quiz_course/README.md).
+QUIZ_COURSE = Path(__file__).parent / "fixtures" / "quiz_course"
 ALL_TITLE = "Part 2 quiz: Python and ROS 2 with rclpy"
 
 
@@ -24,7 +27,7 @@ def _extract(func: object, path: Path) -> list[tuple]:
 
 
 def test_quiz_extractor_gives_contexts_and_real_lines() -> None:
-    path = REPO / "quizzes" / "part2-rclpy.yaml"
+    path = QUIZ_COURSE / "quizzes" / "part2-rclpy.yaml"
     found = {msg[1]: (line, msg[0]) for line, func, msg, _c in _extract(extract_quiz, path)}
     lines = path.read_text().splitlines()
     line, ctx = found["What is the Global Interpreter Lock (GIL)?"]
@@ -40,7 +43,7 @@ def test_identical_strings_in_different_questions_stay_separate(tmp_path: Path) 
     out = tmp_path / "locales"
     from autograder.i18n.tools import extract
 
-    extract(REPO, out)
+    extract(QUIZ_COURSE, out, REPO / "babel.cfg")
     with (out / "content.pot").open("rb") as fh:
         catalog = read_po(fh)
     contexts = sorted(m.context for m in catalog if m.id == "None of the above")
@@ -63,7 +66,7 @@ def course(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     """A small course: one quiz, one exercise, one Python module, one template."""
     shutil.copy(REPO / "babel.cfg", tmp_path / "babel.cfg")
     (tmp_path / "quizzes").mkdir()
-    shutil.copy(REPO / "quizzes" / "part2-rclpy.yaml", tmp_path / "quizzes")
+    shutil.copy(QUIZ_COURSE / "quizzes" / "part2-rclpy.yaml", tmp_path / "quizzes")
     (tmp_path / "assignments" / "timers").mkdir(parents=True)
     (tmp_path / "assignments" / "timers" / "exercise.yaml").write_text(
         "id: timers\ntitle: Timers\nsummary: Two timers.\n")
@@ -157,7 +160,7 @@ def test_babel_accepts_our_extractor_by_module_path() -> None:
     # babel.cfg names the extractor by module path, so pybabel works from a checkout.
     from babel.messages.extract import extract
 
-    source = REPO / "quizzes" / "part2-rclpy.yaml"
+    source = QUIZ_COURSE / "quizzes" / "part2-rclpy.yaml"
     messages = list(extract("autograder.quiz.extract:extract_quiz",
                             io.BytesIO(source.read_bytes())))
     lineno, message, _comments, context = messages[0]

@@ -358,8 +358,8 @@ def test_moodle_refuses_a_share_it_has_no_grade_for(tmp_path: Path) -> None:
     path.write_text(f"id: wide\ntitle: Wide\nquestions:\n  - id: many\n    type: multiple\n"
                     f"    partial_credit: true\n    text: Pick.\n    options: [{options}]\n"
                     f"    answer: [{right}]\n")
-    with pytest.raises(ContentError, match=r"wide.yaml:4: questions\[many\]: Moodle has no grade of "
-                                           r"1/11 of the marks for one answer"):
+    with pytest.raises(ContentError, match=r"wide.yaml:4: questions\[many\]: Moodle has no "
+                                           r"grade of 1/11 of the marks for one answer"):
         export_moodle_xml([load_quiz(path)])
     export_qti([load_quiz(path)])  # QTI maps any share
 

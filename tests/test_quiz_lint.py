@@ -13,12 +13,15 @@ from autograder.i18n import translations
 from autograder.quiz.cli import quiz_cli
 
 REPO = Path(__file__).resolve().parent.parent
+# The quizzes these tests read: a frozen copy, so that editing quizzes/ never breaks a
+# platform test (tests/fixtures/quiz_course/README.md).
+QUIZ_COURSE = Path(__file__).parent / "fixtures" / "quiz_course"
 
 
 @pytest.fixture
 def course(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
-    shutil.copytree(REPO / "quizzes", tmp_path / "quizzes")
-    shutil.copytree(REPO / "locales", tmp_path / "locales")
+    shutil.copytree(QUIZ_COURSE / "quizzes", tmp_path / "quizzes")
+    shutil.copytree(QUIZ_COURSE / "locales", tmp_path / "locales")
     monkeypatch.setenv("AUTOGRADER_COURSE", str(tmp_path))
     monkeypatch.setenv("AUTOGRADER_LOCALES", str(tmp_path / "locales"))
     translations.cache_clear()
@@ -92,8 +95,8 @@ def test_malformed_quiz_and_duplicate_ids_and_tolerance(course: Path) -> None:
     assert code == 1
     assert any(line.startswith(f"{folder / 'broken.yaml'}:3: YAML error") for line in lines)
     assert any("quiz id 'rclpy-part2' is also used by" in line for line in lines)
-    assert any(re.search(r"timer-synchronization.yaml:\d+: questions\[calls-in-two-seconds\].tolerance", line)
-               for line in lines)
+    assert any(re.search(r"timer-synchronization.yaml:\d+: "
+                         r"questions\[calls-in-two-seconds\].tolerance", line) for line in lines)
 
 
 def test_malformed_catalog_is_one_line_naming_it(course: Path) -> None:

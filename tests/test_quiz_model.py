@@ -15,6 +15,9 @@ from autograder.quiz.cli import quiz_cli
 from autograder.quiz.model import load_quiz
 
 REPO = Path(__file__).resolve().parent.parent
+# The quizzes these tests read: a frozen copy, so that editing quizzes/ never breaks a
+# platform test (tests/fixtures/quiz_course/README.md).
+QUIZ_COURSE = Path(__file__).parent / "fixtures" / "quiz_course"
 
 GOOD = """\
 id: tiny
@@ -33,8 +36,8 @@ questions:
 @pytest.fixture
 def course(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     """A copy of the course's quizzes and catalogs that a test may break."""
-    shutil.copytree(REPO / "quizzes", tmp_path / "quizzes")
-    shutil.copytree(REPO / "locales", tmp_path / "locales")
+    shutil.copytree(QUIZ_COURSE / "quizzes", tmp_path / "quizzes")
+    shutil.copytree(QUIZ_COURSE / "locales", tmp_path / "locales")
     monkeypatch.setenv("AUTOGRADER_COURSE", str(tmp_path))
     monkeypatch.setenv("AUTOGRADER_LOCALES", str(tmp_path / "locales"))
     translations.cache_clear()
@@ -43,7 +46,7 @@ def course(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
 
 
 def test_shipped_quizzes_load() -> None:
-    files = load_all(REPO)
+    files = load_all(QUIZ_COURSE)
     ids = {qf.quiz.id for qf in files}
     assert ids == {"rclpy-part2", "parameter-validation", "timer-synchronization",
                    "callback-groups", "error-handling"}
@@ -104,7 +107,8 @@ def test_malformed_quiz_in_cli_is_one_line_and_changes_nothing(course: Path) -> 
     assert result.exit_code == 2
     assert "Traceback" not in result.output
     lines = result.output.strip().splitlines()
-    assert len(lines) == 1 and "part2-rclpy.yaml:8: questions[callback-groups-purpose].type" in lines[0]
+    assert len(lines) == 1
+    assert "part2-rclpy.yaml:8: questions[callback-groups-purpose].type" in lines[0]
     assert not out.exists()
 
 

@@ -17,8 +17,11 @@ from autograder.quiz.scoring import score
 from autograder.quiz.shuffle import option_order
 
 REPO = Path(__file__).resolve().parent.parent
-PART2 = load_quiz(REPO / "quizzes" / "part2-rclpy.yaml").quiz
-ERRORS = load_quiz(REPO / "quizzes" / "error-handling.yaml").quiz
+# The quizzes these tests read: a frozen copy, so that editing quizzes/ never breaks a
+# platform test (tests/fixtures/quiz_course/README.md).
+QUIZ_COURSE = Path(__file__).parent / "fixtures" / "quiz_course"
+PART2 = load_quiz(QUIZ_COURSE / "quizzes" / "part2-rclpy.yaml").quiz
+ERRORS = load_quiz(QUIZ_COURSE / "quizzes" / "error-handling.yaml").quiz
 
 
 def _ids(quiz: object, question_id: str, seed: object) -> list[str]:
@@ -96,7 +99,7 @@ def missing_translation(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path
     """Catalogs where the Part 2 title has no Urdu translation."""
     import shutil
 
-    shutil.copytree(REPO / "locales", tmp_path / "locales")
+    shutil.copytree(QUIZ_COURSE / "locales", tmp_path / "locales")
     po = tmp_path / "locales" / "ur" / "LC_MESSAGES" / "content.po"
     text = po.read_text()
     text = re.sub(r'(msgctxt "quiz:rclpy-part2:title"\nmsgid "[^"]*"\nmsgstr )"[^"]*"',

@@ -16,11 +16,14 @@ from autograder.quiz.catalog import load_all
 from autograder.quiz.server import QuizServer
 
 REPO = Path(__file__).resolve().parent.parent
+# The quizzes these tests read: a frozen copy, so that editing quizzes/ never breaks a
+# platform test (tests/fixtures/quiz_course/README.md).
+QUIZ_COURSE = Path(__file__).parent / "fixtures" / "quiz_course"
 
 
 @pytest.fixture
 def server() -> Iterator[QuizServer]:
-    srv = QuizServer(load_all(REPO), port=0)
+    srv = QuizServer(load_all(QUIZ_COURSE), port=0)
     thread = threading.Thread(target=srv.serve_forever, daemon=True)
     thread.start()
     yield srv

@@ -137,7 +137,8 @@ def test_registered_type_loads_renders_and_scores(any_of: AnyOf) -> None:
 
 
 def test_registered_type_is_checked_by_its_own_rules(any_of: AnyOf) -> None:
-    with pytest.raises(ContentError, match=r"toy.yaml:8: questions\[colour\].answer: the key names no"):
+    with pytest.raises(ContentError,
+                       match=r"toy.yaml:8: questions\[colour\].answer: the key names no"):
         load_quiz("toy.yaml", TOY.replace("[red, blue]", "[red, pink]"))
     with pytest.raises(ContentError, match="only a numeric question has a tolerance"):
         load_quiz("toy.yaml", TOY.replace("answer: [red, blue]",
