@@ -69,6 +69,7 @@ def english_outside_code(output: str, allowed: tuple[set[str], set[str]]) -> lis
         if not re.search(r"[\u0600-\u06ff]", line):
             continue
         prose = _IDENTIFIER.sub("¦", _CODE.sub("¦", line))
+        prose = re.sub(r"\b[A-Z][A-Z0-9]+\b", "¦", prose)  # a metavar or an acronym: a name
         for phrase in _PHRASE.findall(prose):
             parts = re.findall(r"[A-Za-z]+", phrase.lower())
             plain = " ".join(p[:-1] if p.endswith("s") and len(p) > 3 else p for p in parts)
@@ -117,6 +118,12 @@ def test_a_usage_error_in_urdu_has_no_english_prefix(allowed: tuple[set[str], se
     run = _run("--lang", "ur", "check", "no_such_exercise", str(STARTER))
     assert run.returncode == 2
     assert "Error:" not in run.stderr and "خرابی:" in run.stderr, run.stderr
+    # click's own usage errors: a missing argument, an unknown option
+    for args in (("check", EXERCISE), ("check", EXERCISE, str(STARTER), "--bogus")):
+        run = _run("--lang", "ur", *args)
+        assert run.returncode == 2, run.stderr
+        assert "خرابی:" in run.stderr and "استعمال:" in run.stderr, run.stderr
+        assert english_outside_code(run.stderr, allowed) == [], run.stderr
 
 
 # --- no silent English ---------------------------------------------------------------------

@@ -63,6 +63,9 @@ def set_language(lang: str) -> None:
     ``autograder``)."""
     global _active
     _active = lang
+    from autograder.i18n import click_words
+
+    click_words.speak()
     sim.i18n.set_language(lang, lambda: catalog_folder(sim.i18n.get_language()).parent.parent)
 
 
@@ -95,3 +98,8 @@ def content_text(context: str, message: str) -> str:
 def N_(message: str) -> str:
     """Mark ``message`` for extraction without translating it yet (translated when shown)."""
     return message
+
+
+def NN_(singular: str, plural: str) -> tuple[str, str]:
+    """Mark a singular and plural pair for extraction (translated with ``ngettext``)."""
+    return singular, plural

@@ -27,7 +27,7 @@ PLATFORM_DOMAIN = "messages"
 CONTENT_DOMAIN = "content"
 PLATFORM_METHODS = frozenset({"python", "jinja2", "autograder.i18n.label_extract:extract_tests",
                               "sim.worldfile:extract_world"})
-KEYWORDS = {**DEFAULT_KEYWORDS, "N_": None, "NP_": ((1, "c"), 2)}
+KEYWORDS = {**DEFAULT_KEYWORDS, "N_": None, "NP_": ((1, "c"), 2), "NN_": (1, 2)}
 COMMENT_TAGS = ("TRANSLATORS:",)
 PROJECT = "rclpy-autograder"
 
