@@ -184,3 +184,15 @@ def test_validate_fails_where_i18n_check_does(tmp_path: Path) -> None:
     run = _run("validate", "--no-grade", "--course", str(course), course=course)
     assert run.returncode == 1, run.stdout + run.stderr
     assert "README.ur.md" in run.stderr and "چلائیے" in run.stderr, run.stderr
+
+
+def test_true_false_feedback_never_contradicts_itself(tmp_path: Path) -> None:
+    """A right "False" read back: the feedback speaks of the answer, the option chosen is
+    quoted, so the line never reads "your answer is right; your answer: wrong"."""
+    key = _run("quiz", "key", "timer-synchronization")
+    answers = tmp_path / "answers.json"
+    answers.write_text(key.stdout, encoding="utf-8")
+    run = _run("quiz", "score", "timer-synchronization", str(answers), "--lang", "ur")
+    assert run.returncode == 0, run.stderr
+    assert "آپ کا جواب درست ہے۔ آپ نے جواب دیا: «غلط»" in run.stdout, run.stdout
+    assert "آپ کا جواب: غلط" not in run.stdout
