@@ -92,7 +92,7 @@ _CLAUSE_END = re.compile(r"[،؛۔:؟!\n()]|\s(?:جو|جس|جب|تو|کہ|کیو
 # What may stand before a subject in its clause: particles, determiners, and adverbial
 # phrases that end in a postposition ("کھلی جگہ میں check_path ...").
 _LEAD = re.compile(r"^(?:.*\s(?:میں|پر|سے|تک|بعد|پہلے|ساتھ|لیے|بغیر|دوران|اندر|باہر))?\s*"
-                   r"(?:(?:یہ|وہ|پھر|اب|تب|بھی|ہر|ایک|کوئی|وہی|یہی|نہ|ہی|§|0)\s+"
+                   r"(?:(?:یہ|وہ|پھر|اب|تب|بھی|ہر|ایک|کوئی|کسی|وہی|یہی|نہ|ہی|§|0)\s+"
                    r"|\S+ (?:کا|کی|کے) )*$")
 # A verb form by its ending (دیتا، کرے گی) or, short ones, as a whole word (دی, not خالی).
 _MASCULINE_VERB = re.compile(r"(?:تا|گا|سکا|رہا|چکا|ہوا|گیا)$|^(?:دیا|لیا|پایا|تھا)$")
@@ -136,6 +136,7 @@ def agreement(text: str, nouns: Iterable[tuple[str, str, str]],
     service، کا timer).  A noun that ``other_nouns`` (or a Latin word) follows qualifies
     that noun ("Python پروسیس") and is left alone."""
     bare = _PLACEHOLDER.sub("0", CODE_SPAN.sub(lambda m: m.group(0).strip("`"), text))
+    bare = re.sub(r"\([^()]*\)", " ", bare)  # a parenthesis interrupts, it ends no clause
     for word, gender, en in nouns:
         noun = re.compile(rf"(?<![\w./-]){re.escape(word)}(?![\w./-])")
         for found in noun.finditer(bare):
