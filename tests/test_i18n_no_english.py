@@ -107,10 +107,12 @@ def test_list_and_quizzes_in_urdu_have_no_english(allowed: tuple[set[str], set[s
         assert english_outside_code(run.stdout + run.stderr, allowed) == [], run.stdout
 
 
-def test_check_in_urdu_has_no_english(allowed: tuple[set[str], set[str]]) -> None:
-    run = _run("check", EXERCISE, str(STARTER), "--lang", "ur")
+@pytest.mark.parametrize("command", ["check", "grade"])
+def test_check_and_grade_in_urdu_have_no_english(allowed: tuple[set[str], set[str]],
+                                                 command: str) -> None:
+    run = _run(command, EXERCISE, str(STARTER), "--lang", "ur")
     assert run.returncode == 0, run.stderr
-    assert "جانچ" in run.stdout
+    assert "جانچ" in run.stdout + run.stderr
     assert english_outside_code(run.stdout + run.stderr, allowed) == [], run.stdout
 
 
