@@ -143,17 +143,15 @@ def _verbose_option(func):  # noqa: ANN001, ANN202
 @click.option("--json", "as_json", is_flag=True, help="Print JSON for tools.")
 def list_command(as_json: bool) -> None:
     """List the exercises and quizzes."""
-    from autograder.core.exercise import list_exercises
+    from autograder.core.exercise import load_each_exercise
 
-    try:
-        exercises = list_exercises()
-    except ContentError as exc:
-        raise UsageProblem(str(exc)) from None
+    exercises, broken = load_each_exercise()  # a broken file is listed, the others too
     quizzes = _quizzes()
     if as_json:
         click.echo(json.dumps({
             "exercises": [{"id": e.id, "title": e.title, "file": e.file, "node": e.node,
-                           "languages": list(LANGUAGES)} for e in exercises],
+                           "languages": list(LANGUAGES)} for e in exercises]
+                         + [{"id": exc.path.parent.name, "error": str(exc)} for exc in broken],
             "quizzes": [{"id": q.id, "title": q.title, "languages": list(q.languages),
                          **({"error": q.error} if q.error else {})} for q in quizzes],
         }, ensure_ascii=False, indent=2))
@@ -161,6 +159,9 @@ def list_command(as_json: bool) -> None:
     click.echo(_("Exercises:"))
     for e in exercises:
         click.echo(f"  {e.id:<24} {e.localized_title}")
+    for exc in broken:
+        click.echo(f"  {exc.path.parent.name:<24} " + _("not loaded: {error}").format(
+            error=exc))
     if quizzes:
         click.echo(_("Quizzes:"))
         for q in quizzes:

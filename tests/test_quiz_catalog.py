@@ -5,6 +5,7 @@ into the quiz file and score full marks as an answers file (autograder/quiz/cata
 from __future__ import annotations
 
 import json
+import re
 import urllib.request
 from pathlib import Path
 from threading import Thread
@@ -125,3 +126,19 @@ def test_the_key_pastes_back_into_the_file_and_scores_full_marks(course: Path,
     answers.write_text(result.output)
     scored = CliRunner().invoke(quiz_cli, ["score", "good", str(answers)])
     assert scored.exit_code == 0 and "Passed: 5 of 5" in scored.output, scored.output
+
+
+def test_a_broken_exercise_file_is_listed_beside_the_others(course: Path) -> None:
+    import shutil
+
+    shutil.copytree(Path(__file__).parent / "fixtures" / "mini_course" / "assignments" / "shout",
+                    course / "assignments" / "shout")
+    (course / "assignments" / "typo").mkdir()
+    (course / "assignments" / "typo" / "exercise.yaml").write_text("id: typo\ntitle: [\n")
+    result = CliRunner().invoke(main, ["list"])
+    assert result.exit_code == 0, result.output
+    assert "shout" in result.output and "A good quiz" in result.output
+    assert re.search(r"typo +not loaded: .*exercise.yaml:3: YAML error", result.output)
+    listed = json.loads(CliRunner().invoke(main, ["list", "--json"]).output)
+    assert [e["id"] for e in listed["exercises"]] == ["shout", "typo"]
+    assert "error" in listed["exercises"][1]

@@ -11,7 +11,7 @@ from typing import Literal
 from autograder.core.course import course_root
 from autograder.core.names import unknown_exercise
 from autograder.i18n import _, content_text
-from sim.content import build, load_document
+from sim.content import ContentError, build, load_document
 from sim.pacing import DEFAULT_CLOCK_HZ, DEFAULT_CPU_BUDGET
 
 
@@ -152,6 +152,20 @@ def list_exercises() -> list[Exercise]:
     if not root.is_dir():
         return []
     return [load_exercise(p) for p in sorted(root.iterdir()) if (p / "exercise.yaml").exists()]
+
+
+def load_each_exercise() -> tuple[list[Exercise], list[ContentError]]:
+    """Every exercise that loads, and the error of each whose file does not: one bad file
+    is one problem, not every exercise's."""
+    root = assignments_dir()
+    found, errors = [], []
+    for folder in sorted(root.iterdir()) if root.is_dir() else []:
+        if (folder / "exercise.yaml").exists():
+            try:
+                found.append(load_exercise(folder))
+            except ContentError as exc:
+                errors.append(exc)
+    return found, errors
 
 
 def find_exercise(name: str) -> Exercise:
