@@ -224,7 +224,9 @@ def _run(exercise: Exercise, submission: Path | None, plan: _Plan,
         isolation=isolation.mode, lang=get_language(),
         record=str(record) if record is not None else None,
         submission_name=_shown_name(exercise, submission))
-    with tempfile.TemporaryDirectory(prefix="autograder-") as tmp:
+    # A program left running where nothing ends it (basic isolation without a cgroup) may
+    # still write here as it goes: what it keeps is left, never the grader's crash.
+    with tempfile.TemporaryDirectory(prefix="autograder-", ignore_cleanup_errors=True) as tmp:
         running: list[children.Child] = []
         try:
             with contextlib.ExitStack() as lifelines:

@@ -164,7 +164,8 @@ def probe_launch(mode: Mode = "strict") -> str | None:
 
     if mode == "strict":
         bring_up_loopback()
-    with tempfile.TemporaryDirectory(prefix="autograder-probe-") as tmp:
+    with tempfile.TemporaryDirectory(prefix="autograder-probe-",
+                                     ignore_cleanup_errors=True) as tmp:
         script = Path(tmp) / "staged" / "probe.py"
         script.parent.mkdir()
         script.write_text(PROBE_PROGRAM)
