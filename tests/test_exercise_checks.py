@@ -97,3 +97,10 @@ def test_a_course_with_tests_needs_each_exercise_s_proof(course: Path) -> None:
     (course / "tests" / "test_grading_shout.py").write_text('PROOF = Proof("shout")\n')
     assert problems(course) == [f"{variant.parent}:1: no known-bad submission loses the "
                                 "core test test_upper_case"]
+
+
+def test_an_exercise_without_a_public_test_is_named(course: Path) -> None:
+    public = course / "assignments" / "shout" / "tests" / "public"
+    (public / "test_shout.py").rename(public / "shout_checks.py")
+    found = problems(course)
+    assert any(p.startswith(f"{public}:1: no public test") for p in found), found

@@ -60,6 +60,10 @@ def graded_tests(exercise: Exercise) -> list[GradedTest]:
 def check_exercise(exercise: Exercise, root: Path) -> list[Problem]:
     """Every problem of this kind in one exercise."""
     problems = _modules(exercise)
+    if exercise.public_tests.is_dir() and not any(exercise.public_tests.glob("test_*.py")):
+        problems.append(Problem(exercise.public_tests, None, _(
+            "no public test: students get the `test_*.py` files here, and `autograder check` "
+            "runs them")))
     tests = graded_tests(exercise)
     for name, (lang, heading, core_mark) in READMES.items():
         path = exercise.folder / name
