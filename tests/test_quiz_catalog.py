@@ -142,3 +142,16 @@ def test_a_broken_exercise_file_is_listed_beside_the_others(course: Path) -> Non
     listed = json.loads(CliRunner().invoke(main, ["list", "--json"]).output)
     assert [e["id"] for e in listed["exercises"]] == ["shout", "typo"]
     assert "error" in listed["exercises"][1]
+
+
+def test_render_and_export_do_the_others_and_name_the_broken_one(course: Path,
+                                                                 tmp_path: Path) -> None:
+    out = tmp_path / "pages"
+    result = CliRunner().invoke(quiz_cli, ["render", "--format", "html", "--out", str(out)])
+    assert result.exit_code == 2 and "questions[judge].answer" in result.output
+    assert [p.name for p in out.iterdir()] == ["good.en.html"]
+    moodle = tmp_path / "all.xml"
+    result = CliRunner().invoke(quiz_cli, ["export", "--format", "moodle-xml", "--out",
+                                           str(moodle)])
+    assert result.exit_code == 2 and "broken.yaml" in result.output
+    assert "A good quiz" in moodle.read_text()

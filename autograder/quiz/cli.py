@@ -28,7 +28,7 @@ from autograder.i18n import (
 )
 from autograder.i18n.tools import read_catalog
 from autograder.quiz import CONTENT_DOMAIN
-from autograder.quiz.catalog import find_quiz, list_quizzes, load_all, load_each
+from autograder.quiz.catalog import find_quiz, list_quizzes, load_each
 from autograder.quiz.localize import (
     Localizer,
     Text,
@@ -37,7 +37,7 @@ from autograder.quiz.localize import (
     require_translation,
     terminal,
 )
-from autograder.quiz.model import Quiz
+from autograder.quiz.model import Quiz, QuizFile
 from autograder.quiz.render import render_markdown, render_page, render_result
 from autograder.quiz.scoring import (
     file_key,
@@ -132,7 +132,7 @@ def lint_command() -> None:
 def render_command(quizzes: tuple[str, ...], lang: str | None, fmt: str, seed: str | None,
                    out: Path) -> None:
     """Write QUIZ.LANG.html and QUIZ.LANG.mdx (every quiz and language by default)."""
-    files = [find_quiz(q) for q in quizzes] if quizzes else load_all()
+    files, broken = _named_or_each(quizzes)
     langs_for = (lambda quiz: (lang,)) if lang else (lambda quiz: quiz.languages)
     out.mkdir(parents=True, exist_ok=True)
     for qf in files:
@@ -147,6 +147,7 @@ def render_command(quizzes: tuple[str, ...], lang: str | None, fmt: str, seed: s
                 path = out / f"{qf.quiz.id}.{code}.mdx"
                 path.write_text(render_markdown(qf.quiz, code, seed), encoding="utf-8")
                 click.echo(str(path))
+    _left_out(broken)
 
 
 @quiz_cli.command("export")
@@ -169,7 +170,9 @@ def export_command(quizzes: tuple[str, ...], fmt: str, lang: str | None,
     from autograder.quiz.export import export_moodle_xml, export_qti
 
     _use_lang(lang)
-    files = [find_quiz(q) for q in quizzes] if quizzes else load_all()
+    files, broken = _named_or_each(quizzes)
+    if not files:
+        _left_out(broken)
     for qf in files:
         for code in ((lang or "en",) if fmt == "qti" else (lang,) if lang else qf.quiz.languages):
             require_translation(qf, code)
@@ -191,6 +194,23 @@ def export_command(quizzes: tuple[str, ...], fmt: str, lang: str | None,
         raise UsageProblem(_("cannot write {path}: {error}").format(
             path=out, error=exc.strerror or exc)) from None
     click.echo(str(out))
+    _left_out(broken)
+
+
+def _named_or_each(quizzes: tuple[str, ...]) -> tuple[list[QuizFile], list[ContentError]]:
+    """The quizzes named (a broken one is the command's error), or every quiz that loads
+    and the error of each file that does not."""
+    if quizzes:
+        return [find_quiz(q) for q in quizzes], []
+    return load_each()
+
+
+def _left_out(broken: list[ContentError]) -> None:
+    """After the others are done: name each quiz file that was left out, exit 2."""
+    if broken:
+        for exc in broken[:-1]:
+            click.echo(_("not loaded: {error}").format(error=exc), err=True)
+        raise UsageProblem(_("not loaded: {error}").format(error=broken[-1]))
 
 
 # Question and answer texts in a result are cut to this many characters: enough to know
