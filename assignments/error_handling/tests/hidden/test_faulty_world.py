@@ -239,7 +239,12 @@ def test_log_not_flooded(run, student):
         count = warnings_between(run.output, d.wall_start, d.wall_end)
         # Throttled by wall or by ROS time, whichever is longer: both are fair.
         allowed = math.ceil(max(d.end - d.start, d.wall_end - d.wall_start)) + 1
-        if count == 0:
+        # A warning is due once the watchdog acts (a stop sent in the dropout, a tick
+        # before its end at the latest: logged by then). One that never acted, or acted
+        # only at its end or after (a late watchdog, whose lateness in simulation time
+        # depends on the machine's load), is the stop tests' to judge.
+        acted = any(is_zero(m) for m in window(run.commands, d.start, d.end - LATE))
+        if count == 0 and acted:
             raise StudentFailure(
                 _("The lidar was silent for {span:.0f} s ({seconds:.1f} s into the run) and "
                   "the node logged no warning.").format(
