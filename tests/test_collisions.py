@@ -100,3 +100,21 @@ def test_no_samples_or_shapes_is_no_note():
     empty = (world.geometry[0][:0], world.geometry[1][:0])
     assert front_beam_note(contacts, samples, empty) == ""
 
+
+
+def test_a_robot_that_turns_into_a_box_is_judged_by_its_heading_at_contact():
+    """Arcing left, the robot meets a box some 10 degrees off the heading it has at that
+    moment, 76 degrees from the one it started with: the note comes (issue 30)."""
+    world = World(load_world("empty_room"))
+    world.robot.angle = world.control.angle = 0.0
+    turned = 1.0  # where the arc (0.3 m/s, 0.5 rad/s) heads after 2 s
+    x, y = 3 + 0.6 * math.sin(turned), 3 + 0.6 * (1 - math.cos(turned))
+    face = turned + 0.15
+    world.add_obstacle(Box(center=(x + 0.35 * math.cos(face), y + 0.35 * math.sin(face)),
+                           size=(0.1, 0.8), angle=face))
+    sim = drive(world, 0.3, 0.5)
+    samples, contacts = sim.recording.snapshot()
+    assert abs(samples[-1].theta) > math.radians(60)  # far from where it started
+    assert abs(bearing(contacts[0], samples, world.geometry)) < math.radians(20)
+    assert front_beam_note(contacts, samples, world.geometry).startswith(
+        "The robot drove into added box 4 straight ahead.")
