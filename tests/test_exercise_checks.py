@@ -5,21 +5,25 @@ tests' own, test modules pytest can collect, the proof (autograder/commands/exer
 from __future__ import annotations
 
 import shutil
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
 from autograder.commands.validate import validate
+from autograder.i18n import translations
 
 MINI = Path(__file__).parent / "fixtures" / "mini_course"
 
 
 @pytest.fixture
-def course(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+def course(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[Path]:
     root = tmp_path / "course"
     shutil.copytree(MINI, root)
     monkeypatch.setenv("AUTOGRADER_COURSE", str(root))
-    return root
+    translations.cache_clear()  # the grading table reads labels in the course's catalogs
+    yield root
+    translations.cache_clear()
 
 
 def problems(course: Path) -> list[str]:
@@ -104,3 +108,16 @@ def test_an_exercise_without_a_public_test_is_named(course: Path) -> None:
     (public / "test_shout.py").rename(public / "shout_checks.py")
     found = problems(course)
     assert any(p.startswith(f"{public}:1: no public test") for p in found), found
+
+
+def test_an_untranslated_label_is_named_at_its_test(course: Path) -> None:
+    catalog = course / "locales" / "ur" / "LC_MESSAGES" / "messages.po"
+    catalog.parent.mkdir(parents=True)
+    catalog.write_text('msgid ""\nmsgstr ""\n"Content-Type: text/plain; charset=utf-8\\n"\n\n'
+                       'msgid "What it hears comes out upper-cased"\nmsgstr "بڑے حروف میں"\n\n'
+                       'msgid "Each message is answered exactly once"\nmsgstr "ایک بار"\n',
+                       encoding="utf-8")
+    public = course / "assignments" / "shout" / "tests" / "public" / "test_shout.py"
+    line = line_of(public, "def test_starts")
+    assert [p for p in problems(course) if "has no translation" in p] == [
+        f"{public}:{line}: ur: the label of test_starts has no translation in {catalog}"]

@@ -9,10 +9,12 @@ from __future__ import annotations
 import ast
 import dataclasses
 import re
+from collections.abc import Callable
 from pathlib import Path
 
 import yaml
 
+from autograder.core.errors import ContentError
 from autograder.core.exercise import Exercise
 from autograder.i18n import _, translations
 from autograder.i18n.tools import Problem
@@ -74,8 +76,8 @@ def check_exercise(exercise: Exercise, root: Path) -> list[Problem]:
             continue
         lines = path.read_text(encoding="utf-8").splitlines()
         problems += _hand_run(exercise, path, lines, heading)
-        problems += _table(exercise, tests, path, lines, lang, core_mark)
-    problems += _translated(exercise, root)
+        problems += _table(exercise, tests, path, lines, core_mark, _translator(root, lang))
+    problems += _translated(exercise, root) + _labels_translated(tests, root)
     if (root / "tests").is_dir():
         problems += _proof(exercise, root)
     return problems
@@ -127,8 +129,29 @@ def _hand_run(exercise: Exercise, path: Path, lines: list[str],
     return problems
 
 
+def _translator(root: Path, lang: str) -> Callable[[str], str]:
+    """Labels in ``lang`` as the course ``root`` translates them (its catalog, else the
+    package's), whichever course is in use."""
+    from autograder.i18n.tools import read_catalog
+
+    po = root / "locales" / lang / "LC_MESSAGES" / "messages.po"
+    if lang == "en" or not po.exists():
+        return translations(lang).gettext
+    try:
+        catalog = read_catalog(po, lang)
+    except ContentError:
+        return translations(lang).gettext
+
+    def gettext(text: str) -> str:
+        found = catalog.get(text)
+        return str(found.string) if found is not None and found.string and not found.fuzzy \
+            else text
+
+    return gettext
+
+
 def _table(exercise: Exercise, tests: list[GradedTest], path: Path, lines: list[str],
-           lang: str, core_mark: str) -> list[Problem]:
+           core_mark: str, gettext: Callable[[str], str]) -> list[Problem]:
     """The grading table (headed ``| test |``) is each test's label in the README's
     language, its points, public or hidden, and its core mark; one row per test."""
     start = next((n for n, line in enumerate(lines) if line.startswith("| test |")), None)
@@ -142,7 +165,6 @@ def _table(exercise: Exercise, tests: list[GradedTest], path: Path, lines: list[
             break
         cells = tuple(c.strip() for c in lines[n].strip().strip("|").split("|"))
         rows[cells[0].replace("`", "")] = (n + 1, cells[1:])
-    gettext = translations(lang).gettext
     problems = []
     for test in tests:
         label = gettext(test.label).replace("`", "") if test.label else test.name
@@ -181,6 +203,28 @@ def _translated(exercise: Exercise, root: Path) -> list[Problem]:
                 problems.append(Problem(po, found.lineno if found else None, _(
                     "{lang}: no translation of the {field} of {exercise} ({text!r})").format(
                     lang=lang, field=field, exercise=exercise.id, text=text)))
+    return problems
+
+
+def _labels_translated(tests: list[GradedTest], root: Path) -> list[Problem]:
+    """Each test's label has its translation in each messages catalog the course keeps: a
+    student grading in Urdu reads it (``i18n extract`` adds new labels to the catalogs
+    only when it is run; this says so before)."""
+    from autograder.i18n.tools import read_catalog
+
+    problems = []
+    for po in sorted((root / "locales").glob("*/LC_MESSAGES/messages.po")):
+        lang = po.parent.parent.name
+        try:
+            catalog = read_catalog(po, lang)
+        except Exception:  # noqa: BLE001 - a malformed catalog is i18n check's to report
+            continue
+        for test in tests:
+            found = catalog.get(test.label) if test.label else None
+            if test.label and (found is None or not found.string or found.fuzzy):
+                problems.append(Problem(test.path, test.line, _(
+                    "{lang}: the label of {test} has no translation in {catalog}").format(
+                    lang=lang, test=test.name, catalog=po)))
     return problems
 
 
