@@ -14,6 +14,7 @@ from pathlib import Path
 
 import yaml
 
+from autograder.commands.scan_readme import check_scan_readme
 from autograder.core.errors import ContentError
 from autograder.core.exercise import Exercise
 from autograder.i18n import _, translations
@@ -77,6 +78,7 @@ def check_exercise(exercise: Exercise, root: Path) -> list[Problem]:
         lines = path.read_text(encoding="utf-8").splitlines()
         problems += _hand_run(exercise, path, lines, heading)
         problems += _table(exercise, tests, path, lines, core_mark, _translator(root, lang))
+        problems += check_scan_readme(exercise, path, "\n".join(lines))
     problems += _translated(exercise, root) + _labels_translated(tests, root)
     if (root / "tests").is_dir():
         problems += _proof(exercise, root)
