@@ -9,7 +9,8 @@ with the shape's isolation and whether the grade is official. Where the README's
 model table says a shape stops an attack, a test here tries it in that shape. In the two
 basic shapes the student is the grader's user: the programs that act on whatever the
 grader's user runs (stopping, joining or starving other gradings) are graded alone there,
-since what they do to a classmate's grading is what basic isolation does not stop."""
+since what they do to a classmate's grading (or, left running, to the next one) is what
+basic isolation does not stop."""
 
 from __future__ import annotations
 
@@ -48,9 +49,10 @@ MINI = REPO / "tests" / "fixtures" / "mini_course"
 CORPUS = REPO / "tests" / "submissions" / "hostile"
 NAMES = sorted(p.name for p in CORPUS.iterdir())
 AUTOGRADER = Path(sys.executable).with_name("autograder")
-# What acts on every process and domain of the grader's user: alone where that is the
-# student's too.
-ALONE_IN_BASIC = ("holds_every_domain", "joins_other_domain", "stops_the_grader")
+# What acts on every process and domain of the grader's user (stopping, tracing, joining,
+# hoarding): alone where that user is the student's too.
+ALONE_IN_BASIC = ("holds_every_domain", "joins_other_domain", "snoops_processes",
+                  "stops_the_grader")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -83,7 +85,7 @@ class Graded:
 
 
 def _batch(shape: Shape, work: Path, names: list[str], jobs: int) -> None:
-    submissions = work / f"submissions-{jobs}"
+    submissions = work / f"submissions-{names[0]}"
     for name in names:
         shutil.copytree(CORPUS / name, submissions / name)
     for path in [submissions, *submissions.rglob("*")]:
@@ -91,7 +93,7 @@ def _batch(shape: Shape, work: Path, names: list[str], jobs: int) -> None:
     env = {**clean_env(os.environ.get("PATH", "")), "HOME": str(work),
            "AUTOGRADER_COURSE": str(work / "course"), "XDG_CACHE_HOME": str(work / "cache")}
     command = [*shape.prefix, str(AUTOGRADER), "grade-batch", "shout", str(submissions),
-               "--csv", str(work / "out" / f"gradebook-{jobs}.csv"), "--out", str(work / "out"),
+               "--csv", str(work / "out" / f"gradebook-{names[0]}.csv"), "--out", str(work / "out"),
                "--jobs", str(jobs), *([] if shape.official else ["--allow-unofficial"])]
     done = subprocess.run(command, env=env, cwd=work, capture_output=True, text=True,
                           timeout=1500)
@@ -111,7 +113,8 @@ def shape_run(request: pytest.FixtureRequest) -> Iterator[tuple[Shape, dict[str,
             path.chmod(0o755 if path.is_dir() else 0o644)
         if shape.mode == "basic":
             _batch(shape, work, [n for n in NAMES if n not in ALONE_IN_BASIC], jobs=2)
-            _batch(shape, work, list(ALONE_IN_BASIC), jobs=1)
+            for name in ALONE_IN_BASIC:  # each in a batch (and PID namespace) of its own:
+                _batch(shape, work, [name], jobs=1)  # what it leaves ends with that batch
         else:
             _batch(shape, work, NAMES, jobs=2)
         graded = {}
@@ -216,10 +219,15 @@ def test_the_graders_processes_cannot_be_stopped_or_traced(shape_run):
 
 
 def test_a_stopped_grading_is_the_graders_failure_and_its_memory_closed(shape_run):
+    """The grading's pytest process and the grader itself are not dumpable: neither is
+    read nor traced (a trace would stop it) by a program of the same user; a stopped
+    pytest process makes the grading the grader's failure."""
     _in(shape_run, "basic-as-root", "ordinary-user")
     g = shape_run[1]["stops_the_grader"]
     assert g.results["grader_error"] and g.results["isolation"]["official"] is False
     assert "MEM OPENED" not in g.log
+    assert "NoNewPrivs" in shape_run[1]["snoops_processes"].log  # it ran, traced, and the
+    # batch that graded it went on to the end (a traced grader would have stopped there)
 
 
 def test_tampering_with_the_world_is_caught(shape_run):
