@@ -19,11 +19,25 @@ from autograder.quiz.scoring import check_answers, key_answers, score
 from autograder.quiz.server import QuizServer
 
 REPO = Path(__file__).resolve().parent.parent
+# The quizzes these tests read: a frozen copy, so that editing quizzes/ never breaks a
+# platform test (tests/fixtures/quiz_course/README.md).
+QUIZ_COURSE = Path(__file__).parent / "fixtures" / "quiz_course"
+
+
+@pytest.fixture(autouse=True)
+def _quiz_course(monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
+    """Pages are translated with the fixture's own content catalog."""
+    from autograder.i18n import translations
+
+    monkeypatch.setenv("AUTOGRADER_COURSE", str(QUIZ_COURSE))
+    translations.cache_clear()
+    yield
+    translations.cache_clear()
 
 
 @pytest.fixture
 def server() -> Iterator[QuizServer]:
-    srv = QuizServer(load_all(REPO), port=0)
+    srv = QuizServer(load_all(QUIZ_COURSE), port=0)
     thread = threading.Thread(target=srv.serve_forever, daemon=True)
     thread.start()
     yield srv
@@ -87,7 +101,7 @@ _LAYOUT_JS = """
 def urdu_page(tmp_path: Path, quiz_file: str) -> Iterator[Any]:
     """The Urdu page of ``quizzes/<quiz_file>.yaml`` (seed 7) open in Chromium, fonts
     loaded."""
-    quiz = load_quiz(REPO / "quizzes" / f"{quiz_file}.yaml").quiz
+    quiz = load_quiz(QUIZ_COURSE / "quizzes" / f"{quiz_file}.yaml").quiz
     html = tmp_path / f"{quiz_file}.ur.html"
     html.write_text(render_page(quiz, "ur", seed=7), encoding="utf-8")
     with chromium_page() as page:
@@ -189,7 +203,7 @@ def _comparable(quiz: Quiz, answers: dict[str, Any]) -> dict[str, Any]:
 def test_saved_answers_file_scores_full_marks_for_every_type(tmp_path: Path) -> None:
     # Without a server, each question type's reader builds the answers file in the page.
     with chromium_page() as page:
-        for qf in load_all(REPO):
+        for qf in load_all(QUIZ_COURSE):
             quiz = qf.quiz
             html = tmp_path / f"{quiz.id}.en.html"
             html.write_text(render_page(quiz, "en", seed=5), encoding="utf-8")
@@ -207,3 +221,40 @@ def test_saved_answers_file_scores_full_marks_for_every_type(tmp_path: Path) -> 
                     == _comparable(quiz, key_answers(quiz)["answers"])), quiz.id
             result = score(quiz, check_answers("answers.json", quiz, saved))
             assert result.score == result.max_score, quiz.id
+
+
+@pytest.mark.parametrize("lang", ["en", "ur"])
+def test_the_saved_page_says_what_it_cannot_read_and_saves_nothing(tmp_path: Path,
+                                                                   lang: str) -> None:
+    """Without a server too: `five` in a number box, or two items in one place, is said at
+    its question; Urdu digits read as a number, as the server reads them."""
+    timers = load_quiz(QUIZ_COURSE / "quizzes" / "timer-synchronization.yaml").quiz
+    errors = load_quiz(QUIZ_COURSE / "quizzes" / "error-handling.yaml").quiz
+    said = {"en": ("is not a number", "Two items have the same place, 1"),
+            "ur": ("کوئی عدد نہیں", "دو چیزوں کا مقام ایک ہی ہے")}[lang]
+    with chromium_page() as page:
+        for quiz, fill in ((timers, lambda: page.fill('input[name="q:calls-in-two-seconds"]',
+                                                      "five")),
+                           (errors, lambda: [page.select_option(
+                               f'select[name="q:life-order:{item}"]', "1")
+                               for item in ("init", "create")])):
+            html = tmp_path / f"{quiz.id}.{lang}.html"
+            html.write_text(render_page(quiz, lang, seed=5), encoding="utf-8")
+            page.goto(html.as_uri())
+            fill()
+            downloads: list[Any] = []
+            page.on("download", lambda d: downloads.append(d))
+            page.click("#save")
+            problem = page.locator("p.problem")
+            problem.wait_for()
+            assert said[quiz is errors] in problem.inner_text()
+            assert downloads == []
+        html = tmp_path / "timers.html"
+        html.write_text(render_page(timers, lang, seed=5), encoding="utf-8")
+        page.goto(html.as_uri())
+        page.fill('input[name="q:calls-in-two-seconds"]', "۸")
+        with page.expect_download() as download:
+            page.click("#save")
+        saved = json.loads(Path(download.value.path()).read_text())
+        assert saved["answers"] == {"calls-in-two-seconds": 8}
+
