@@ -10,7 +10,7 @@ plugin, by name; docs/instructors/writing-exercises.md walks through each with a
         probe.wait_sim(5.0)
 
 ``probe`` (:class:`Probe`, module scope): the grader's own node on the graph; ``subscribe``
-gives an :class:`Inbox`, whose ``messages`` (not the inbox itself) are the list::
+gives an :class:`Inbox`: iterate it, or take its ``messages`` as a list::
 
     inbox: Inbox[String] = probe.subscribe(String, "/greeting")
     probe.publish(String, "name", String(data="Ada"))

@@ -66,3 +66,15 @@ def test_wait_quiet_is_not_fooled_by_a_flood_even_past_the_limit(monkeypatch):
         done.set()
         flooder.join()
     assert inbox.dropped > 0
+
+
+def test_iterating_an_inbox_gives_its_messages_as_they_stand():
+    """`for msg in inbox` works as an instructor first writes it (issue 33: an Inbox was
+    not iterable): a snapshot of the messages, which later arrivals do not change."""
+    inbox: Inbox[str] = Inbox("/greeting")
+    inbox.add(0.5, "Hello, Ada!")
+    inbox.add(0.7, "Hello, Alan!")
+    snapshot = iter(inbox)
+    inbox.add(0.9, "Hello, Grace!")
+    assert list(snapshot) == ["Hello, Ada!", "Hello, Alan!"]
+    assert list(inbox) == inbox.messages and len(list(inbox)) == len(inbox) == 3

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import threading
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 from typing import Any, Generic, TypeVar
 
 from rcl_interfaces.msg import SetParametersResult
@@ -121,6 +121,11 @@ class Inbox(Generic[M]):
     def __len__(self) -> int:
         with self._lock:
             return len(self._items)
+
+    def __iter__(self) -> Iterator[M]:
+        """The messages so far, in arrival order (``for msg in inbox``: a snapshot, as
+        ``inbox.messages`` is)."""
+        return iter(self.messages)
 
     def clear(self) -> None:
         with self._lock:
