@@ -9,6 +9,8 @@ included, that grades ``/autograder/submission`` into ``/autograder/results/resu
 
 from __future__ import annotations
 
+import ast
+import re
 import shutil
 import stat
 import zipfile
@@ -74,6 +76,25 @@ def student_files(exercise: Exercise) -> list[Path]:
     return files
 
 
+def hidden_test_names(exercise: Exercise) -> set[str]:
+    """The names of the exercise's hidden test functions (read, not imported)."""
+    names: set[str] = set()
+    for path in sorted(exercise.hidden_tests.rglob("*.py")) if exercise.hidden_tests.is_dir() \
+            else []:
+        names |= {node.name for node in ast.walk(ast.parse(path.read_text(encoding="utf-8")))
+                  if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef)
+                  and node.name.startswith("test")}
+    return names
+
+
+def without_hidden_names(text: str, hidden: set[str]) -> str:
+    """exercise.yaml as a student gets it: no line that names a hidden test (its ``core``
+    entries among them; a student's ``check`` runs the public tests only)."""
+    kept = [line for line in text.splitlines(keepends=True)
+            if not set(re.findall(r"\btest_\w+", line)) & hidden]
+    return "".join(kept)
+
+
 def build_release(out: Path, exercises: list[Exercise] | None = None) -> Path:
     """Write the student release to ``out`` (which must not exist yet)."""
     from autograder.quiz.catalog import load_all
@@ -85,6 +106,9 @@ def build_release(out: Path, exercises: list[Exercise] | None = None) -> Path:
     for exercise in exercises or list_exercises():
         for path in student_files(exercise):
             _copy(path, out / "assignments" / exercise.id / path.relative_to(exercise.folder))
+        released = out / "assignments" / exercise.id / "exercise.yaml"
+        released.write_text(without_hidden_names(released.read_text(encoding="utf-8"),
+                                                 hidden_test_names(exercise)), encoding="utf-8")
     pages = out / "quizzes-rendered"
     quizzes = load_all()
     _write_student_readmes(out, exercises or list_exercises(), [qf.quiz for qf in quizzes])
