@@ -21,6 +21,7 @@ import unicodedata
 from collections import Counter
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any
 
 import pytest
@@ -59,6 +60,15 @@ class Run:
 
     def count(self, text: str) -> int:
         return _unmarked(self.stdout).replace(RLM, "").count(text)
+
+
+def _marked(test: dict, lang: str) -> str:
+    """A test's label as its line shows it: with the core mark of its language."""
+    from autograder.quiz.localize import using_language
+    from autograder.render.verdict import core_label
+
+    with using_language(lang):
+        return core_label(SimpleNamespace(label=test["label"], core=test["core"]))
 
 
 def _unmarked(text: str) -> str:
@@ -119,7 +129,8 @@ def test_each_test_line_and_each_failure_once(runs, name):
     assert run.code == 0, run.stderr
     tests = run.results["tests"]
     assert run.results["grader_error"] is None
-    assert run.test_lines() == Counter(t["label"] for t in tests), run.stdout
+    assert run.test_lines() == Counter(_marked(t, run.results["lang"]) for t in tests), \
+        run.stdout
     revealed = [t for t in tests if t["status"] == "failed" and t["reveal"] == "message"]
     for hint in {t["hint"].splitlines()[0] for t in revealed if t["hint"]}:
         assert run.count(hint) == 1, (hint, run.stdout)  # tests that share it: once too
