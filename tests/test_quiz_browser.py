@@ -243,7 +243,7 @@ def test_the_saved_page_says_what_it_cannot_read_and_saves_nothing(tmp_path: Pat
             page.goto(html.as_uri())
             fill()
             downloads: list[Any] = []
-            page.on("download", lambda d: downloads.append(d))
+            page.on("download", lambda d, into=downloads: into.append(d))
             page.click("#save")
             problem = page.locator("p.problem")
             problem.wait_for()
