@@ -336,7 +336,10 @@ def _refused(exercise: Exercise, message: str, elapsed: float) -> RunResult:
         hint=_("Nothing was graded: fix this, then check again."))
     return RunResult(kind="exercise", id=exercise.id, title=exercise.localized_title,
                      tests=(test,), pass_mark=exercise.pass_fraction, lang=get_language(),
-                     execution_time=elapsed, data={"refused": True})
+                     execution_time=elapsed, data={
+                         "refused": True,  # nothing ran; the shape it would have run in:
+                         "isolation": {**detect().to_dict(), "bounds": None,
+                                       "student_uids": None}})
 
 
 def _forged(exercise: Exercise, elapsed: float) -> RunResult:
