@@ -68,6 +68,27 @@ def read_process_state(pid: int) -> ProcessState:
     return ProcessState(busy, cpu)
 
 
+def runqueue_wait_ns(pid: int) -> int:
+    """Nanoseconds the threads of ``pid`` have spent runnable but waiting for a CPU (the
+    second field of ``/proc/<pid>/task/*/schedstat``): what a busy machine took from it.
+    0 if it is gone, the kernel keeps no such count, or it has children (then the wait
+    may be its own doing: a program that forks spinning children starves itself)."""
+    base = f"/proc/{pid}/task/"
+    try:
+        tids = os.listdir(base)
+    except OSError:
+        return 0
+    waited = 0
+    for tid in tids:
+        try:
+            if _read_file(f"{base}{tid}/children", 64).strip():
+                return 0
+            waited += int(_read_file(f"{base}{tid}/schedstat", 128).split()[1])
+        except (OSError, ValueError, IndexError):
+            continue
+    return waited
+
+
 def _read_file(path: str, size: int) -> bytes:
     fd = os.open(path, os.O_RDONLY | os.O_CLOEXEC)
     try:

@@ -73,7 +73,7 @@ class World:
 
 def start(graph: Graph, world: World, stale: set[bytes]) -> StudentNode:
     probe = SimpleNamespace(node=graph, node_names=graph.names, world=world)
-    process = SimpleNamespace(running=lambda: True, started_at=0.0, returncode=None)
+    process = SimpleNamespace(running=lambda: True, started_at=0.0, returncode=None, pid=0)
     node = StudentNode(process, NAME, probe)
     exercise = SimpleNamespace(node=NAME, startup_timeout=20.0, file="obstacle_avoider.py")
     _wait_for_node(exercise, node, world, stale)
@@ -116,3 +116,46 @@ def test_a_first_start_is_done_when_its_publishers_appear():
 def test_other_nodes_publishers_are_not_the_students():
     graph = Graph([Info("sim_world", b"w"), Info(NAME, b"a"), Info("talker", b"t")])
     assert _node_endpoints(SimpleNamespace(node=graph), NAME) == {b"a"}
+
+
+class Clock:
+    """Wall time that moves one second per look at the graph."""
+
+    def __init__(self, graph: Graph) -> None:
+        self.graph, self.start = graph, 1000.0
+
+    def __call__(self) -> float:
+        return self.start + self.graph.looks
+
+
+def test_time_spent_waiting_for_a_cpu_does_not_count_toward_the_start_up(monkeypatch):
+    """A busy machine keeps the program waiting for a CPU 0.9 s of every second: its node
+    shows after 30 s of wall time, 3 s of its own, within a 10 s start-up."""
+    from autograder.sandbox import graph as graph_module
+
+    graph = Graph([], [Info(NAME, b"new")], delay=30)
+    monkeypatch.setattr(graph_module.time, "monotonic", Clock(graph))
+    found = graph_module.wait_until_up(World(graph), graph, NAME, set(), lambda: True, 10.0,
+                                       lambda: 0.9 * graph.looks)
+    assert found == {b"new": NAME}
+    graph = Graph([], [Info(NAME, b"new")], delay=30)  # on a quiet machine: given up at 10 s
+    monkeypatch.setattr(graph_module.time, "monotonic", Clock(graph))
+    assert graph_module.wait_until_up(World(graph), graph, NAME, set(), lambda: True,
+                                      10.0) == {}
+    assert graph.looks == 11
+
+
+def test_a_start_up_starved_past_its_cap_is_the_graders_failure(monkeypatch):
+    from autograder.core.errors import GraderError
+    from autograder.sandbox import graph as graph_module
+
+    graph = Graph([], [Info(NAME, b"new")], delay=500)
+    monkeypatch.setattr(graph_module.time, "monotonic", Clock(graph))
+    try:
+        graph_module.wait_until_up(World(graph), graph, NAME, set(), lambda: True, 10.0,
+                                   lambda: float(graph.looks))  # it never got a CPU
+    except graph_module.Starved as exc:
+        assert isinstance(exc, GraderError) and "too busy" in str(exc)
+    else:
+        raise AssertionError("a starved start-up was judged")
+    assert graph.looks == 41  # 4 x 10 s of wall time

@@ -20,6 +20,7 @@ from autograder.plugin.probe import GRADER_NODES
 from autograder.plugin.stash import reporter_key, settings_key, startup_key
 from autograder.plugin.timing import Timing, module_of
 from autograder.sandbox.graph import node_endpoints, wait_until_up
+from sim.procstate import runqueue_wait_ns
 
 if TYPE_CHECKING:
     from autograder.core.exercise import Exercise
@@ -208,8 +209,9 @@ def _wait_for_node(exercise: Exercise, node: StudentNode, world: SimBridge,
     """Wait, with simulation time held, until this instance's node is on the graph: a
     start-up is then the same in simulation time however long the machine takes (imports,
     discovery), and the node's first tick is the next one."""
+    pid = node.process.pid
     found = wait_until_up(world, node.probe.node, exercise.node, stale, node.running,
-                          exercise.startup_timeout)
+                          exercise.startup_timeout, lambda: runqueue_wait_ns(pid) / 1e9)
     if found:
         node.startup_seconds = time.monotonic() - node.process.started_at
         node.appeared_at = world.now

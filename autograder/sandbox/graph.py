@@ -15,6 +15,9 @@ from collections.abc import Callable, Iterable
 from contextlib import AbstractContextManager
 from typing import Protocol
 
+from autograder.core.errors import GraderError
+from autograder.i18n import _
+
 # Every rclpy node publishes on these (its log and its parameter events): the endpoints
 # that tell one instance of a node from another of the same name.
 NODE_TOPICS = ("/rosout", "/parameter_events")
@@ -47,23 +50,49 @@ def node_endpoints(graph: Graph, name: str | None) -> dict[bytes, str]:
 
 
 def wait_until_up(world: HeldWorld, graph: Graph, name: str | None, stale: Iterable[bytes],
-                  running: Callable[[], bool], timeout: float) -> dict[bytes, str]:
+                  running: Callable[[], bool], timeout: float,
+                  waited: Callable[[], float] = lambda: 0.0) -> dict[bytes, str]:
     """Wait, with simulation time held, until node ``name`` (any node: None) has publishers
-    not in ``stale``, the program stops ``running``, or ``timeout`` wall seconds pass (the
+    not in ``stale``, the program stops ``running``, or ``timeout`` seconds pass (the
     start-up is the machine's business: imports, discovery). The new publishers, if any.
 
+    The seconds the program spent ``waited`` for a CPU (a busy machine's doing) do not
+    count, so a start-up's verdict does not depend on the load; a program starved for
+    :data:`STARVED_FACTOR` times ``timeout`` raises :class:`Starved`, the grader's failure.
     A start-up thus costs the same simulation time on any machine, and the node's first
     tick is the one after this returns."""
-    deadline = time.monotonic() + timeout
+    started, waited_before = time.monotonic(), waited()
+    cap = started + timeout * STARVED_FACTOR
     stale = set(stale)
     found: dict[bytes, str] = {}
+    starved = False
 
     def ready() -> bool:
-        nonlocal found
+        nonlocal found, starved
         found = {gid: node for gid, node in node_endpoints(graph, name).items()
                  if gid not in stale}
-        return bool(found) or not running() or time.monotonic() > deadline
+        now = time.monotonic()
+        starved = now > cap
+        return bool(found) or not running() or starved \
+            or now - started - (waited() - waited_before) > timeout
 
     with world.held():
-        world.wait_for(ready, sim_timeout=math.inf, wall_timeout=timeout + 1)
+        world.wait_for(ready, sim_timeout=math.inf, wall_timeout=timeout * STARVED_FACTOR + 1)
+    if starved and not found and running():
+        raise Starved(timeout * STARVED_FACTOR, waited() - waited_before)
     return found
+
+
+STARVED_FACTOR = 4
+"""A start-up may take this many times its timeout in wall time while the machine keeps
+the program waiting for a CPU."""
+
+
+class Starved(GraderError):
+    """The machine kept a starting program waiting for a CPU too long to judge its
+    start-up: the grader's failure, never the student's."""
+
+    def __init__(self, seconds: float, waited: float) -> None:
+        super().__init__(_("The machine was too busy to judge the start-up: in {seconds:.0f} s "
+                           "the program waited {waited:.0f} s for a CPU. Grade again on a "
+                           "quieter machine.").format(seconds=seconds, waited=waited))
