@@ -214,8 +214,8 @@ def refuse_unofficial(option: str) -> None:
     if not isolation.official:
         raise GraderFault(_(
             "This machine cannot give official grades ({reason}): a student's program would "
-            "run as the grader's user and could change its result. Grade as root (README: "
-            "\"Untrusted code\"), or pass {option} to grade anyway, unofficially.").format(
+            "run as the grader's user and could change its result. Grade as root (see "
+            "docs/operators/security.md), or pass {option} to grade anyway, unofficially.").format(
             reason=_(isolation.reason), option=option))
 
 

@@ -27,11 +27,11 @@ from autograder.i18n import _, ngettext
 # error_handling's 16 students went at 294 an hour at 0.75 (3 at once), 448 at 1.25 (5)
 # and 596 with 8 at once (2.0 at its 0.46 of a core), and 8 at once graded faster than 4
 # for every exercise but parameter_validation, and than 1.25's choice for all five, every
-# score full (README "How many at once"). A grading that fills a core by itself gets two
-# per core: no faster, no slower.
+# score full (docs/contributors/measurements.md). A grading that fills a core by itself
+# gets two per core: no faster, no slower.
 TARGET_LOAD = 2.0
 # Most gradings at once: the highest concurrency measured to keep every score full
-# (README "A whole class", benchmarks/bench_batch.py).
+# (docs/contributors/measurements.md, benchmarks/bench_batch.py).
 MAX_JOBS = 8
 # Resident memory of one grading (pytest child, simulator, student node), measured ~250 MB;
 # rounded up so a node that allocates more still fits.

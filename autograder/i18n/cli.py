@@ -1,6 +1,6 @@
 """``autograder i18n``: extract, update, compile and check the gettext catalogs.
 
-Equivalent pybabel commands are in the README's instructor section; these read
+Equivalent pybabel commands are in docs/instructors/translating.md; these read
 ``babel.cfg`` and write two templates, ``locales/messages.pot`` (the platform) and
 ``locales/content.pot`` (quizzes and exercise titles).
 """
