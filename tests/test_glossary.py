@@ -281,10 +281,10 @@ def test_the_course_follows_its_glossary(real_course: None) -> None:
 
 
 def test_the_readme_answers_file_scores(real_course: None, tmp_path: Path) -> None:
-    """README.md's sample answers file is one `quiz score` accepts."""
-    text = (REPO / "README.md").read_text()
+    """The students' quiz guide's sample answers file is one `quiz score` accepts."""
+    text = (REPO / "docs" / "students" / "quizzes.md").read_text()
     sample = re.search(r'An answers file looks\s+like `(\{"quiz".*?\}\})`', text, re.S)
-    assert sample, "README.md has no sample answers file"
+    assert sample, "docs/students/quizzes.md has no sample answers file"
     answers = json.loads(sample.group(1).replace("\n", " "))
     path = tmp_path / "answers.json"
     path.write_text(json.dumps(answers))

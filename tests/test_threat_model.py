@@ -1,6 +1,6 @@
-"""The README's table of attacks and machine shapes is this one, word for word, and every
-cell that says an attack is stopped names the test that tries it in that shape (issues 28
-and 29). Run with ``-s`` to see the table printed."""
+"""The threat model's table of attacks and machine shapes (docs/operators/security.md) is
+this one, word for word, and every cell that says an attack is stopped names the test that
+tries it in that shape (issues 28 and 29). Run with ``-s`` to see the table printed."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import re
 from pathlib import Path
 
 TESTS = Path(__file__).resolve().parent
-README = TESTS.parent / "README.md"
+PAGE = TESTS.parent / "docs" / "operators" / "security.md"
 
 SHAPES = ("root with namespaces: strict", "root in a container: user",
           "root in a container without CAP_SETUID: basic", "an ordinary user: basic")
@@ -99,7 +99,7 @@ TABLE: list[tuple[str, Cell, Cell, Cell, Cell]] = [
 
 
 def render() -> str:
-    """The table as the README holds it."""
+    """The table as the security page holds it."""
     lines = [f"| attack | {' | '.join(SHAPES)} |", "|---" * (len(SHAPES) + 1) + "|"]
     for attack, *cells in TABLE:
         lines.append(f"| {attack} | {' | '.join(text for text, _proof in cells)} |")
@@ -113,9 +113,9 @@ def _test_names() -> set[str]:
     return names
 
 
-def test_the_readme_holds_this_table():
+def test_the_security_page_holds_this_table():
     print("\n" + render())
-    assert render() in README.read_text(encoding="utf-8")
+    assert render() in PAGE.read_text(encoding="utf-8")
 
 
 def test_every_stopped_attack_names_a_test_that_exists():
