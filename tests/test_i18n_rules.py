@@ -162,6 +162,21 @@ def test_every_gendered_term_of_the_issue_has_its_gender(real: Glossary) -> None
     assert "check_path" in next(t for t in real.terms if t.en == "service").names
 
 
+@pytest.mark.parametrize("urdu", [
+    "جب سامنے 0.40 m پر ایک ڈبہ ہو، تو راستہ صاف نہیں تھا۔",
+    "جب scan پرانا ہو تو جواب غلط تھا",
+])
+def test_a_present_when_clause_with_a_past_main_verb_is_caught(real: Glossary,
+                                                                urdu: str) -> None:
+    assert any("tense clash" in m for m in _said(real, urdu))
+
+
+def test_one_tense_in_a_sentence_passes(real: Glossary) -> None:
+    for urdu in ("جب سامنے 0.40 m پر ایک ڈبہ ہو، تو راستہ صاف نہیں ہے۔",
+                 "جب سامنے ایک ڈبہ تھا، تو راستہ صاف نہیں تھا۔"):
+        assert not any("tense clash" in m for m in _said(real, urdu))
+
+
 # 5. Register ----------------------------------------------------------------------------
 @pytest.mark.parametrize(("urdu", "plain"), [
     ("public tests چلائیے", "چلائیں"), ("دنیا کو اکیلے شروع کیجیے", "کریں"),

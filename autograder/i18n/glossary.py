@@ -202,6 +202,7 @@ class Glossary:
         README's paragraph: ``lines`` and the offsets where they ``starts`` in it)."""
         found = [*rules.code_outside_spans(text, translated=True),
                  *rules.polite_imperatives(prose(text)),
+                 *rules.tense_clashes(prose(text)),
                  *rules.agreement(text, self.gendered, self.nouns),
                  *rules.direct_before_postposition(text, self.oblique)]
         for what, message in found:

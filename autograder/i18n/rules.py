@@ -64,6 +64,19 @@ _NOT_IMPERATIVE = frozenset({
 _POLITE = re.compile(r"(?:یجیے|یجئے|ئیے|یئے|یے)$")
 
 
+# A "when" clause in the present or subjunctive ("جب ... ہو،") whose sentence ends in the
+# past ("... تھا۔"): fragments spliced from two messages, each in its own tense.
+_TENSE_CLASH = re.compile(r"جب[^۔\n]*?\s(?:ہو|ہوں|ہے|ہیں)(?:،|\s)[^۔\n]*?\s(?:تھا|تھی|تھے)"
+                          r"(?=\s*(?:۔|$))")
+
+
+def tense_clashes(text: str) -> Iterator[tuple[str, str]]:
+    """Sentences whose "when" clause is in the present and whose main verb is in the past."""
+    for match in _TENSE_CLASH.finditer(text):
+        yield match.group(0), _("a present \"when\" clause with a past main verb (tense "
+                                "clash): {text!r}").format(text=match.group(0))
+
+
 def polite_imperatives(text: str) -> Iterator[tuple[str, str]]:
     """Imperatives in the polite -یے form (the subjunctive -ائے of "جو وہ چلائے" is not one)."""
     for match in _IMPERATIVE.finditer(text):
