@@ -30,7 +30,7 @@ from autograder.grading.children import Progress, Watchers
 from autograder.grading.footprint import Footprint
 from autograder.grading.modules import ModuleJobs, children_for, find_modules, merge, share_out
 from autograder.i18n import _, get_language
-from autograder.sandbox.domains import DomainLock, NoDomain, hold_domain, udp_sockets
+from autograder.sandbox.domains import DomainLock, NoDomain, bound_on_domains, hold_domain
 from autograder.sandbox.isolation import (
     Isolation,
     close_to_others,
@@ -39,7 +39,6 @@ from autograder.sandbox.isolation import (
     run_prefix,
     student_uid,
 )
-from autograder.sandbox.sweep import user_processes
 
 GRADER_FAULT = "the autograder failed, tell your instructor"
 # A grading that other users' programs disturbed is done again once they are gone, at
@@ -73,19 +72,20 @@ def grade(exercise: Exercise, submission: Path | None, *, hidden: bool = True,
         if result.grader_error is None or not strangers or len(disturbed) >= REGRADES:
             break
         disturbed.append(strangers)  # what it saw proves nothing: again, once they left
-        _wait_until_gone(strangers, exercise.time_limit)
+        _wait_until_gone(strangers, result.data.get("domains") or [], exercise.time_limit)
     if disturbed:
         result = dataclasses.replace(result, data={**result.data, "disturbed": disturbed})
     return result
 
 
-def _wait_until_gone(uids: Sequence[int], seconds: float) -> None:
-    """Wait (up to ``seconds``) until no process and no socket of ``uids`` is left on the
-    machine: another grading's student ends with its grading, within its time limit."""
+def _wait_until_gone(uids: Sequence[int], domains: Sequence[int], seconds: float) -> None:
+    """Wait (up to ``seconds``) until the strangers ``uids`` have no socket left on the
+    grading's ``domains`` (another grading's student ends with its grading, within its
+    time limit); the grading again takes a domain no one is on."""
     deadline = time.monotonic() + seconds
     while time.monotonic() < deadline:
-        if not any(user_processes(uid) for uid in uids) and \
-                not any(uid in uids for _port, uid in udp_sockets()):
+        if not any(uid in uids and domain in domains
+                   for domain, uid in bound_on_domains()):
             return
         time.sleep(0.2)
 
