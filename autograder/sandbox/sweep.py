@@ -41,9 +41,10 @@ def user_processes(uid: int, proc: str = "/proc") -> list[int]:
             if owner == uid and state != b"Z"]
 
 
-def kill_user(uid: int, timeout: float = 5.0) -> bool:
+def kill_user(uid: int, timeout: float = 30.0) -> bool:
     """SIGKILL every process of ``uid`` until none is left (or ``timeout`` wall seconds
-    pass); whether none is left."""
+    pass); whether none is left. A killed process is listed until the kernel has freed it,
+    which a busy machine can take seconds over: the wait is for that, not for the kill."""
     if not is_student_uid(uid) or uid in (os.getuid(), os.geteuid()):
         raise ValueError(f"will not sweep uid {uid}: not a student's own user")
     deadline = time.monotonic() + timeout
