@@ -45,8 +45,8 @@ JOBS = {
     # The fast tier: everything but the tests marked `slow` (each grades submissions end to
     # end in the simulator): about a minute on an idle 2-core machine, 2 to 3 under load.
     "test": [["python", "-m", "pytest", "-m", "not slow", "--durations=10"]],
-    # Everything, as CI runs it (about 30 minutes on 2 cores: 28 min 41 s). The ten slowest steps close the run:
-    # where the suite's minutes go, in every CI log.
+    # Everything, as CI runs it (about 30 minutes on 2 cores: 28 min 41 s). The ten
+    # slowest steps close the run: where the suite's minutes go, in every CI log.
     "test-all": [["python", "-m", "pytest", "--durations=10"]],
     "lint": [["ruff", "check", "."]],
     "bench": [["python", "benchmarks/bench_grading.py"], ["python", "benchmarks/bench_sim.py"],
