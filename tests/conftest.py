@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import sys
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 
@@ -77,3 +78,10 @@ def proof(request: pytest.FixtureRequest) -> Proof:
 def graded(proof: Proof, tmp_path_factory: pytest.TempPathFactory) -> dict[str, RunResult]:
     """Every submission of the module's PROOF, graded once for all its checks."""
     return proof.grade_all(tmp_path_factory.mktemp("submissions"))
+
+
+def pytest_sessionfinish(session: pytest.Session) -> None:
+    """Close the Chromium that the browser tests share (tests/browser.py), if they ran."""
+    browser = sys.modules.get("browser")
+    if browser is not None:
+        browser.close_browser()
