@@ -10,6 +10,7 @@ from pathlib import Path
 
 import pytest
 from proving import STANDARD_CHECKS, Proof
+from student_runs import StudentRuns
 
 from autograder.core.results import RunResult
 from autograder.sandbox.domains import reserve_domain
@@ -24,6 +25,15 @@ def ros_domain() -> Iterator[int]:
     os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
     with reserve_domain() as domain:
         yield domain
+
+
+@pytest.fixture(scope="session")
+def student_runs(tmp_path_factory: pytest.TempPathFactory) -> Iterator[StudentRuns]:
+    """``check`` and ``grade`` as a student runs them, each once for every module that
+    reads it (tests/student_runs.py)."""
+    runs = StudentRuns(tmp_path_factory.mktemp("student-runs"))
+    yield runs
+    runs.close()
 
 
 @contextlib.contextmanager
