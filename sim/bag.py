@@ -24,8 +24,8 @@ from typing import Any
 import yaml
 from mcap.writer import CompressionType, Writer
 
+from content.i18n import _, ngettext
 from sim import msgdefs
-from sim.i18n import _, ngettext
 
 # (topic, ROS type name, message, simulation time in seconds); a tap must not raise.
 Tap = Callable[[str, str, Any, float], None]

@@ -18,8 +18,8 @@ from typing import TYPE_CHECKING, Any, Protocol
 import click
 from click.core import ParameterSource
 
-from sim.content import ContentError
-from sim.i18n import _
+from content import ContentError
+from content.i18n import _
 from sim.keyboard import Command
 from sim.pacing import DEFAULT_CLOCK_HZ
 from sim.worldfile import load_world, title_of, world_names, world_path

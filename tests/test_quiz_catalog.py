@@ -20,7 +20,7 @@ from autograder.quiz.cli import quiz_cli
 from autograder.quiz.model import load_quiz
 from autograder.quiz.scoring import score
 from autograder.quiz.server import QuizServer
-from sim.content import ContentError
+from content import ContentError
 
 GOOD = """\
 id: good

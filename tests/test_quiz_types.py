@@ -32,7 +32,7 @@ from autograder.quiz.types.base import (
     one_picked_id,
 )
 from autograder.quiz.views import QuestionView, question_views
-from sim.content import Document
+from content import Document
 
 REPO = Path(__file__).resolve().parent.parent
 SHIPPED = {"single", "multiple", "true_false", "numeric", "ordering"}

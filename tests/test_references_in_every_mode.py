@@ -15,11 +15,11 @@ import pytest
 from conftest import modes_kept
 from proving import Variant, failed_tests, failures, load_variants
 
-from autograder.core.course import course_root
 from autograder.core.exercise import Exercise, list_exercises
 from autograder.core.results import RunResult
 from autograder.grading.run import grade
 from autograder.sandbox import isolation
+from content.course import course_root
 
 pytestmark = [pytest.mark.slow,
               pytest.mark.skipif(os.geteuid() != 0, reason="isolation by user needs root")]

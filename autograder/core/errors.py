@@ -1,12 +1,13 @@
 """The exception families: the student's failure, our own fault, a malformed content file.
 
-:class:`ContentError` (``path:line: field: message``) is defined by the content layer in
-``sim.content``, the lowest layer; the autograder imports it from here.
+:class:`ContentError` (``path:line: field: message``) belongs to the content layer
+(:mod:`content`), below the simulator and the autograder; it is listed here with the other
+two families.
 """
 
 from __future__ import annotations
 
-from sim.content import ContentError
+from content import ContentError
 
 __all__ = ["ContentError", "Disturbed", "GraderError", "StudentFailure"]
 

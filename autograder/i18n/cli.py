@@ -12,11 +12,11 @@ from pathlib import Path
 import click
 
 from autograder.commands.exits import UsageProblem, report_problems
-from autograder.core.course import course_root
 from autograder.core.errors import ContentError
 from autograder.i18n import LANGUAGES, _, locales_dir
 from autograder.i18n.glossary import check_language
 from autograder.i18n.tools import Problem, check_catalog, compile_catalogs, extract, update
+from content.course import course_root
 
 _TARGETS = tuple(lang for lang in LANGUAGES if lang != "en")
 

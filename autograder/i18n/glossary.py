@@ -26,7 +26,7 @@ from babel.messages.catalog import Catalog, Message
 from autograder.core.errors import ContentError
 from autograder.i18n import _, rules
 from autograder.i18n.tools import Problem, read_catalog
-from sim.content import Document, build, load_document
+from content import Document, build, load_document
 
 GLOSSARY_FILE = "glossary.yaml"
 

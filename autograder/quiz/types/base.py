@@ -18,7 +18,7 @@ from autograder.quiz.localize import Localizer, format_number, terminal
 from autograder.quiz.model import Option, Question, Quiz, check_id
 from autograder.quiz.shuffle import attempt_rng, shuffle_unpinned
 from autograder.quiz.views import OptionView, QuestionView
-from sim.content import Document
+from content import Document
 
 if TYPE_CHECKING:  # the exports build on the types: imported only for annotations
     from autograder.quiz.export.moodle import MoodleWriter

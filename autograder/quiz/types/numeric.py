@@ -19,7 +19,7 @@ from autograder.quiz.model import Question, Quiz
 from autograder.quiz.types import register
 from autograder.quiz.types.base import Form, LintNote, QuestionType, Where, first_value
 from autograder.quiz.views import QuestionView
-from sim.content import Document
+from content import Document
 
 if TYPE_CHECKING:
     from autograder.quiz.export.moodle import MoodleWriter

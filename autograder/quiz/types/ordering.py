@@ -23,7 +23,7 @@ from autograder.quiz.types.base import (
     picked_ids,
 )
 from autograder.quiz.views import QuestionView
-from sim.content import Document
+from content import Document
 
 if TYPE_CHECKING:
     from autograder.quiz.export.moodle import MoodleWriter

@@ -17,7 +17,7 @@ from autograder.quiz.types import register
 from autograder.quiz.types.base import Where, one_option_problem
 from autograder.quiz.types.single import SingleChoice
 from autograder.quiz.views import OptionView
-from sim.content import Document
+from content import Document
 
 if TYPE_CHECKING:
     from autograder.quiz.export.moodle import MoodleWriter
