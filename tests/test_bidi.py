@@ -16,8 +16,8 @@ from click.testing import CliRunner
 from autograder.cli import main
 from autograder.core.results import RunResult, TestResult
 from autograder.i18n import get_language, set_language, translations
+from autograder.i18n.text import LRI, PDI, Text, markdown_inline, plain, rich, sentence
 from autograder.quiz.cli import quiz_cli
-from autograder.quiz.localize import LRI, PDI, Text, markdown_inline, plain, rich, sentence
 from autograder.render.html import to_html
 from autograder.render.terminal import RLM, for_terminal, rtl_notice, to_terminal
 from sim.physics import Contact, describe
@@ -235,7 +235,7 @@ def test_a_programs_output_in_a_message_stays_left_to_right_line_by_line() -> No
     """An Urdu message that ends with the program's output: the sentence is right to left,
     the traceback is kept line by line in a left-to-right block (folded into the sentence
     it read backwards)."""
-    from autograder.quiz.localize import with_output
+    from autograder.i18n.text import with_output
 
     message = ("نوڈ کا پروسیس ختم ہو گیا۔ اس کی آخری سطریں:\n"
                'Traceback (most recent call last):\n  File "avoider.py", line 55\n'

@@ -23,10 +23,9 @@ from typing import Literal
 
 from babel.messages.catalog import Catalog, Message
 
-from autograder.core.errors import ContentError
 from autograder.i18n import _, rules
 from autograder.i18n.tools import Problem, read_catalog
-from content import Document, build, load_document
+from content import ContentError, Document, build, load_document
 
 GLOSSARY_FILE = "glossary.yaml"
 

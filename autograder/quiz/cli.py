@@ -26,17 +26,11 @@ from autograder.i18n import (
     locales_dir,
     set_language,
 )
+from autograder.i18n.text import Text, format_number, format_percent, terminal
 from autograder.i18n.tools import read_catalog
 from autograder.quiz import CONTENT_DOMAIN
 from autograder.quiz.catalog import find_quiz, list_quizzes, load_each
-from autograder.quiz.localize import (
-    Localizer,
-    Text,
-    format_number,
-    format_percent,
-    require_translation,
-    terminal,
-)
+from autograder.quiz.localize import Localizer, require_translation
 from autograder.quiz.model import Quiz, QuizFile
 from autograder.quiz.render import render_markdown, render_page, render_result
 from autograder.quiz.scoring import (

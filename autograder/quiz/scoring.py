@@ -17,7 +17,8 @@ from typing import Any
 from autograder.core.errors import ContentError
 from autograder.core.results import RunResult, TestResult
 from autograder.i18n import _, ngettext
-from autograder.quiz.localize import Localizer, format_number, format_percent, using_language
+from autograder.i18n.text import format_number, format_percent, using_language
+from autograder.quiz.localize import Localizer
 from autograder.quiz.model import Quiz
 from autograder.quiz.types import question_type
 

@@ -18,7 +18,7 @@ from markupsafe import escape
 
 from autograder.core.errors import ContentError
 from autograder.i18n import LANGUAGES, _
-from autograder.quiz.localize import using_language
+from autograder.i18n.text import using_language
 from autograder.quiz.model import Quiz, QuizFile
 from autograder.quiz.render import render_index, render_page, render_result
 from autograder.quiz.scoring import check_answers, score

@@ -15,8 +15,8 @@ from typing import Any
 
 from autograder.core.results import RunResult, number
 from autograder.i18n import is_rtl
-from autograder.quiz.localize import Text, format_percent, using_language
-from autograder.quiz.render import environment
+from autograder.i18n.templates import environment
+from autograder.i18n.text import Text, format_percent, using_language
 from autograder.render import OutputFormat, replay
 from autograder.render.charts import intervals_svg
 from autograder.render.verdict import core_heading, core_label

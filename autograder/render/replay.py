@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, Any
 from markupsafe import Markup
 
 from autograder.core.results import RunResult
-from autograder.quiz.localize import Text
+from autograder.i18n.text import Text
 
 if TYPE_CHECKING:  # sim is imported when a report is drawn, not with the renderers
     from sim.recorder import Recording

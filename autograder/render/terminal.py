@@ -20,7 +20,7 @@ from babel.numbers import format_percent
 
 from autograder.core.results import RunResult, TestResult, as_decimal, number
 from autograder.i18n import _, get_language, is_rtl, ngettext
-from autograder.quiz.localize import CODE_SPAN, LRI, PDI, ltr_runs
+from autograder.i18n.text import CODE_SPAN, LRI, PDI, ltr_runs
 from autograder.render.verdict import core_label, core_lines
 
 RLM = "\u200f"

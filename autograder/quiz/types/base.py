@@ -14,7 +14,8 @@ from fractions import Fraction
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from autograder.i18n import _, ngettext, pgettext
-from autograder.quiz.localize import Localizer, format_number, terminal
+from autograder.i18n.text import format_number, terminal
+from autograder.quiz.localize import Localizer
 from autograder.quiz.model import Option, Question, Quiz, check_id
 from autograder.quiz.shuffle import attempt_rng, shuffle_unpinned
 from autograder.quiz.views import OptionView, QuestionView

@@ -14,7 +14,8 @@ from babel.numbers import format_decimal
 
 from autograder.core.results import exact
 from autograder.i18n import N_, _
-from autograder.quiz.localize import Localizer, babel_locale, markdown_inline, terminal
+from autograder.i18n.text import babel_locale, markdown_inline, terminal
+from autograder.quiz.localize import Localizer
 from autograder.quiz.model import Question, Quiz
 from autograder.quiz.types import register
 from autograder.quiz.types.base import Form, LintNote, QuestionType, Where, first_value

@@ -6,7 +6,7 @@ from fractions import Fraction
 from typing import TYPE_CHECKING, Any
 
 from autograder.i18n import _
-from autograder.quiz.localize import markdown_inline
+from autograder.i18n.text import markdown_inline
 from autograder.quiz.model import Question
 from autograder.quiz.types import register
 from autograder.quiz.types.base import (

@@ -11,7 +11,8 @@ from fractions import Fraction
 from typing import TYPE_CHECKING, Any
 
 from autograder.i18n import _
-from autograder.quiz.localize import Localizer, Text
+from autograder.i18n.text import Text
+from autograder.quiz.localize import Localizer
 from autograder.quiz.model import Question, Quiz
 from autograder.quiz.types import register
 from autograder.quiz.types.base import Where, one_option_problem
