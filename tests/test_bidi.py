@@ -14,10 +14,10 @@ import pytest
 from click.testing import CliRunner
 
 from autograder.cli import main
+from autograder.cli.quiz import quiz_cli
 from autograder.core.results import RunResult, TestResult
 from autograder.i18n import get_language, set_language, translations
 from autograder.i18n.text import LRI, PDI, Text, markdown_inline, plain, rich, sentence
-from autograder.quiz.cli import quiz_cli
 from autograder.render.html import to_html
 from autograder.render.terminal import RLM, for_terminal, rtl_notice, to_terminal
 from sim.physics import Contact, describe

@@ -21,7 +21,7 @@ from pathlib import Path
 import pytest
 from markupsafe import escape
 
-from autograder.cli import write_outputs
+from autograder.commands.grade import write_outputs
 from autograder.core.exercise import find_exercise
 from autograder.core.results import RunResult
 from autograder.grading.run import grade

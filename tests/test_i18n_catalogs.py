@@ -10,8 +10,8 @@ import pytest
 from babel.messages.pofile import read_po
 from click.testing import CliRunner
 
+from autograder.cli.i18n import i18n_cli
 from autograder.i18n import translations
-from autograder.i18n.cli import i18n_cli
 from autograder.quiz.extract import extract_exercise, extract_quiz
 
 REPO = Path(__file__).resolve().parent.parent

@@ -162,7 +162,7 @@ def test_results_list_the_bags_and_warnings() -> None:
 
 def test_grade_batch_records_each_student_in_a_folder_of_their_own(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    from autograder import cli
+    from autograder.commands import grade
     from autograder.grading import run
 
     monkeypatch.setenv("AUTOGRADER_COURSE", str(COURSE))
@@ -170,7 +170,7 @@ def test_grade_batch_records_each_student_in_a_folder_of_their_own(
     monkeypatch.setattr(run, "grade", lambda exercise, path, record=None, **_kw:
                         asked.append(record))
     (tmp_path / "bob").mkdir()
-    grade_one, _, _ = cli._batch_item("shout", tmp_path / "bags")
+    grade_one, _, _ = grade.batch_item("shout", tmp_path / "bags")
     grade_one(tmp_path / "alice.py")
     grade_one(tmp_path / "bob")
     assert asked == [tmp_path / "bags" / "alice", tmp_path / "bags" / "bob"]

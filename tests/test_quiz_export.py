@@ -24,11 +24,11 @@ from typing import Any
 import pytest
 from click.testing import CliRunner
 
+from autograder.cli.quiz import quiz_cli
 from autograder.core.errors import ContentError
 from autograder.i18n import _
 from autograder.i18n.text import CODE_SPAN, LRI, PDI, Text, using_language
 from autograder.quiz.catalog import load_all
-from autograder.quiz.cli import quiz_cli
 from autograder.quiz.export import export_moodle_xml, export_qti
 from autograder.quiz.export.xml import CData, el, to_xml
 from autograder.quiz.localize import Localizer

@@ -12,10 +12,10 @@ from typing import Any
 import pytest
 from click.testing import CliRunner
 
+from autograder.cli.quiz import quiz_cli
 from autograder.core.errors import ContentError
 from autograder.i18n.text import markdown_inline
 from autograder.quiz.catalog import load_all
-from autograder.quiz.cli import quiz_cli
 from autograder.quiz.model import Question, load_quiz
 from autograder.quiz.render import render_markdown, render_page
 from autograder.quiz.scoring import check_answers, key_answers, score

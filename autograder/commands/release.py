@@ -23,7 +23,7 @@ from content.course import course_root
 
 # The platform itself: what `pip install .` needs and what runs the tests.
 PLATFORM = ("pyproject.toml", "README.md", "tasks.py", "Makefile", "babel.cfg", "autograder",
-            "sim", "locales")
+            "content", "sim", "locales")
 _IGNORE = shutil.ignore_patterns("__pycache__", "*.pyc", "*.mo", ".*")
 
 

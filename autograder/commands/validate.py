@@ -104,7 +104,7 @@ def validate(root: Path | None = None, *, run_gradings: bool = True, jobs: int =
     """Every problem in the course tree (``root`` defaults to the course in use)."""
     from autograder.grading.run import grade
     from autograder.i18n import locales_dir
-    from autograder.i18n.cli import check_all
+    from autograder.i18n.glossary import check_all
     from autograder.quiz.lint import lint
     from content.course import course_root
 

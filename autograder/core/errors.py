@@ -1,4 +1,5 @@
-"""The exception families: the student's failure, our own fault, a malformed content file.
+"""The exception families: the student's failure, our own fault, the user's bad input (a
+malformed content file among it).
 
 :class:`ContentError` (``path:line: field: message``) belongs to the content layer
 (:mod:`content`), below the simulator and the autograder; it is listed here with the other
@@ -9,7 +10,7 @@ from __future__ import annotations
 
 from content import ContentError
 
-__all__ = ["ContentError", "Disturbed", "GraderError", "StudentFailure"]
+__all__ = ["ContentError", "Disturbed", "GraderError", "StudentFailure", "UsageError"]
 
 
 class StudentFailure(AssertionError):
@@ -19,6 +20,11 @@ class StudentFailure(AssertionError):
         super().__init__(message)
         self.message = message
         self.hint = hint
+
+
+class UsageError(Exception):
+    """Bad input from the user (a missing file, an unknown exercise): one line saying what
+    is wrong, the user's to fix. The CLI ends with exit status 2."""
 
 
 class GraderError(Exception):

@@ -1,7 +1,7 @@
 """``autograder quiz``: list, lint, render, export, take, score, key and serve quizzes.
 
 A thin click layer: each command calls plain functions of the quiz package, and every
-bad input becomes one line naming the file (see ``autograder.commands.exits``).
+bad input becomes one line naming the file (see ``autograder.cli.exits``).
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from typing import Any, TypeVar
 
 import click
 
-from autograder.commands.exits import UsageProblem, report_problems
+from autograder.cli.exits import UsageProblem, report_problems
 from autograder.commands.written import say_written
 from autograder.core.errors import ContentError
 from autograder.core.results import RunResult

@@ -16,7 +16,7 @@ puts the whole graph in a network namespace of its own, where ``sim drive`` and
 command its ``--node`` and ``--exercise`` options from here, and hands the node to the
 world as a :class:`sim.cli.Companion`.
 
-Exit codes as for every command (:mod:`autograder.commands.exits`), and 1 when the
+Exit codes as for every command (:mod:`autograder.cli.exits`), and 1 when the
 program did not get its node up.
 """
 
@@ -34,8 +34,8 @@ from typing import TYPE_CHECKING, Any
 import click
 from click.core import ParameterSource
 
+from autograder.cli.exits import GraderFault, UsageProblem
 from autograder.commands import stale
-from autograder.commands.exits import GraderFault, UsageProblem
 from autograder.commands.stale import hand_folder
 from autograder.core.errors import ContentError
 from autograder.core.output import describe_exit
