@@ -1,5 +1,5 @@
 """Test modules shared out among child pytests and their reports merged
-(autograder.grading.modules), and one grading run that way end to end."""
+(autograder.grading.module_groups), and one grading run that way end to end."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ from autograder.core.exercise import load_exercise
 from autograder.core.report import RawReport, RawTest
 from autograder.core.results import RunResult
 from autograder.grading.children import Child, Ended
-from autograder.grading.modules import children_for, find_modules, merge, share_out
+from autograder.grading.module_groups import children_for, find_modules, merge, share_out
 from autograder.grading.run import GRADER_FAULT, _result
 
 PUBLIC, HIDDEN_A, HIDDEN_B = "tests/public/test_p.py", "tests/hidden/test_a.py", \

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from autograder.commands.grade import batch_item, write_outputs
-from autograder.core.output import (
+from autograder.core.output_budget import (
     CUT,
     LINE_CHARS,
     TAIL_BYTES,

@@ -136,7 +136,7 @@ def write_outputs(result: RunResult, outputs: dict[str, Path | None],
     to FILE with suffix ``.log`` (``log`` names another file for it). Each (format, path)
     written, in order."""
     from autograder.core.files import write_atomically
-    from autograder.core.output import log_beside
+    from autograder.core.output_budget import log_beside
     from autograder.render import formats
 
     outputs = dict(outputs)

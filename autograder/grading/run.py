@@ -4,7 +4,7 @@ a :class:`~autograder.core.results.RunResult`.
 The tests (and the world and probe they use) run in child processes, so a crash there is
 reported as a grader fault instead of taking the CLI down, and a run past its time limit
 is stopped with everything it started.  Test modules run in several children at once,
-each on a ROS domain of its own (:mod:`autograder.grading.modules`), so a grading takes
+each on a ROS domain of its own (:mod:`autograder.grading.module_groups`), so a grading takes
 about as long as its slowest module.
 """
 
@@ -28,7 +28,13 @@ from autograder.grading import children
 from autograder.grading.capacity import machine_cores
 from autograder.grading.children import Progress, Watchers
 from autograder.grading.footprint import Footprint
-from autograder.grading.modules import ModuleJobs, children_for, find_modules, merge, share_out
+from autograder.grading.module_groups import (
+    ModuleJobs,
+    children_for,
+    find_modules,
+    merge,
+    share_out,
+)
 from autograder.i18n import _, get_language
 from autograder.sandbox.domains import DomainLock, NoDomain, bound_on_domains, hold_domain
 from autograder.sandbox.isolation import (
@@ -256,7 +262,7 @@ def _run(exercise: Exercise, submission: Path | None, plan: _Plan,
 def _memory(children_peaks: dict[str, float] | None,
             footprint_mb: float | None) -> dict[str, float]:
     """The results' ``memory``: the children's peak resident sizes, summed (an upper bound,
-    see :func:`autograder.grading.modules.merge`), and ``footprint_mb``, the peak of the
+    see :func:`autograder.grading.module_groups.merge`), and ``footprint_mb``, the peak of the
     whole grading's summed PSS as sampled (:mod:`autograder.grading.footprint`), if any
     sample was taken."""
     memory = dict(children_peaks or {})
