@@ -128,7 +128,7 @@ def test_check_in_urdu_marks_lines_and_points_to_the_report(
         progress(RawTest("t.py::test_starts", "test_starts", "node شروع ہوتا ہے", 1,
                          "visible", "all", True, "passed"))
         run = _urdu_run()
-        started = dataclasses.replace(run.tests[0], data={"nodeid": "t.py::test_starts"})
+        started = dataclasses.replace(run.tests[0], nodeid="t.py::test_starts")
         return dataclasses.replace(run, lang=get_language(), tests=(started, *run.tests[1:]))
 
     monkeypatch.setattr("autograder.grading.run.grade", fake_grade)
@@ -221,7 +221,7 @@ def test_urdu_report_has_no_english_collisions_or_world_names(urdu_catalog: Path
         "test_b.py": Recording("empty_room", samples, []).to_dict(),
     }
     page = to_html(RunResult(run.kind, run.id, run.title, run.tests, lang="ur",
-                             data={"recordings": recordings}))
+                             recordings=recordings))
     for english in ("wall 3", "box 0", "box 1", "circle 2", "Room with obstacles",
                     "Empty room"):
         assert english not in page, english

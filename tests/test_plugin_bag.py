@@ -154,7 +154,7 @@ def test_the_grader_warns_when_the_folder_cannot_be_made(tmp_path: Path) -> None
 
 def test_results_list_the_bags_and_warnings() -> None:
     result = RunResult(kind="exercise", id="x", title="X", tests=(),
-                       data={"bags": {"test_a": "/r/test_a"}, "warnings": ["disk full"]})
+                       bags={"test_a": "/r/test_a"}, warnings=("disk full",))
     shown = result.to_dict()
     assert shown["bags"] == {"test_a": "/r/test_a"} and shown["warnings"] == ["disk full"]
     assert "bags" not in RunResult(kind="exercise", id="x", title="X", tests=()).to_dict()

@@ -231,7 +231,7 @@ def _summary(quiz: Quiz, result: RunResult) -> str:
         mark = "✔" if t.status == "passed" else "✘"
         lines.append(f" {mark} {format_number(n, lang)}. {_short(terminal(Text(t.label, lang)))} "
                      f"({format_number(t.score, lang)}/{format_number(t.max_score, lang)})")
-        answer = t.data.get("answer")
+        answer = t.answer
         said = t.message
         question = quiz.question(t.name)
         if answer is not None and question is not None:

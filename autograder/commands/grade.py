@@ -119,13 +119,13 @@ def _say_recorded(result: RunResult, record: Path | None) -> None:
     """Where ``--record`` put the bags, and any warning about them (on stderr)."""
     from autograder.render.terminal import for_terminal
 
-    bags = result.data.get("bags", {})
+    bags = result.bags
     if record is not None and bags:
         click.echo(for_terminal(ngettext(
             "{count} recording (rosbag2, MCAP) written to {path}",
             "{count} recordings (rosbag2, MCAP) written to {path}", len(bags)).format(
             count=len(bags), path=record)), err=True)
-    for warning in result.data.get("warnings", []):
+    for warning in result.warnings:
         click.echo(for_terminal(_("Warning: {message}").format(message=warning)), err=True)
 
 

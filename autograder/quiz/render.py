@@ -84,7 +84,7 @@ def _feedback(quiz: Quiz, result: RunResult
     for t in result.tests:
         q = quiz.question(t.name)
         assert q is not None, t.name
-        given = t.data.get("answer")
+        given = t.answer
         answer = None if given is None else Text(
             question_type(q.type).answer_text(quiz, q, given, loc), result.lang)
         rows.append((t, loc.text(q, "text"),

@@ -39,7 +39,7 @@ def _tests(result: RunResult, lang: str) -> list[dict[str, Any]]:
             "charts": [{"svg": intervals_svg([tuple(p) for p in chart["points"]],
                                              chart.get("limit"), chart["title"]),
                         "limit": chart.get("limit") is not None}
-                       for chart in test.data.get("charts", []) if chart.get("points")],
+                       for chart in test.charts if chart.get("points")],
             "score": number(test.score), "max_score": number(test.max_score),
         })
     return tests

@@ -93,11 +93,11 @@ def figures(result: RunResult, exercise_folder: Path | None) -> list[Figure]:
 
     labels: dict[str, list[Text]] = {}
     for test in result.tests:
-        module = test.data.get("module")
+        module = test.module
         if module:
             labels.setdefault(module, []).append(Text(test.label, result.lang))
     worlds: dict[str, list[tuple[str, Recording, dict[str, Any]]]] = {}
-    for module, recorded in result.data.get("recordings", {}).items():
+    for module, recorded in result.recordings.items():
         try:
             recording = Recording.from_dict(recorded)
         except Exception:  # noqa: BLE001 - a run we cannot read is left out
