@@ -124,7 +124,7 @@ def test_check_in_urdu_marks_lines_and_points_to_the_report(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     from autograder.core.report import RawTest
 
-    def fake_grade(exercise, submission, *, progress=None, **_kw):  # noqa: ANN001, ANN202
+    def fake_grade(exercise, submission, *, progress=None, **_kw):
         progress(RawTest("t.py::test_starts", "test_starts", "node شروع ہوتا ہے", 1,
                          "visible", "all", True, "passed"))
         run = _urdu_run()

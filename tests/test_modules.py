@@ -229,7 +229,7 @@ def test_grade_batch_runs_modules_at_once_only_when_it_grades_one_at_a_time(
     monkeypatch.setenv("AUTOGRADER_COURSE", str(SHOUT.parent.parent))
     asked: list[int | str] = []
 
-    def fake_grade(exercise, path, *, module_jobs="auto", **_kw):  # noqa: ANN001, ANN202
+    def fake_grade(exercise, path, *, module_jobs="auto", **_kw):
         asked.append(module_jobs)
         return RunResult(kind="exercise", id="shout", title="Shout", tests=())
 

@@ -70,7 +70,7 @@ def graph(ros_domain: int) -> Iterator[tuple[Probe, Node, list[tuple[str, str, A
         rclpy.try_shutdown(context=context)
 
 
-def test_the_probe_hands_over_each_message_once(graph) -> None:  # noqa: ANN001
+def test_the_probe_hands_over_each_message_once(graph) -> None:
     probe, student, tapped = graph
     status = probe.subscribe(String, "/status")
     odom = probe.subscribe(Odometry, "/odom")
@@ -102,7 +102,7 @@ class FakeBridge:
         self.taps.append(tap)
 
 
-def _request(tmp_path: Path, record: Path, module: str = "tests/public/test_drive.py"):  # noqa: ANN202
+def _request(tmp_path: Path, record: Path, module: str = "tests/public/test_drive.py"):
     config = SimpleNamespace(stash=pytest.Stash())
     config.stash[settings_key] = RunSettings(exercise="/course/assignments/drive",
                                             record=str(record))

@@ -12,7 +12,7 @@ import shutil
 import signal
 from collections.abc import Callable
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import click
 
@@ -25,6 +25,8 @@ from autograder.i18n import LANGUAGES, _, ngettext, set_language
 
 if TYPE_CHECKING:
     from autograder.core.exercise import Exercise
+
+F = TypeVar("F", bound=Callable[..., Any])
 
 
 def _sim_cli() -> click.Command:
@@ -115,7 +117,7 @@ def _exercise(name: str) -> Exercise:
     return exercise(name)
 
 
-def _lang_option(func):  # noqa: ANN001, ANN202
+def _lang_option(func: F) -> F:
     """``--lang`` on a subcommand too (``autograder grade ... --lang ur``)."""
 
     def set_lang(ctx: click.Context, param: click.Parameter, value: str | None) -> None:
@@ -131,7 +133,7 @@ VERBOSE = "autograder.verbose"
 """``ctx.meta`` key: ``--verbose`` was given (see :func:`_verbose_option`)."""
 
 
-def _verbose_option(func):  # noqa: ANN001, ANN202
+def _verbose_option(func: F) -> F:
     """``--verbose``: the instructor's technical lines (how the program was contained and
     bounded) instead of the student's sentence."""
 
@@ -209,7 +211,7 @@ def start(exercise: str, directory: Path | None) -> None:
         file=target / found.file, exercise=found.id))
 
 
-def _formats(func):  # noqa: ANN001, ANN202
+def _formats(func: F) -> F:
     """A ``--NAME FILE`` option per output format (autograder.render)."""
     from autograder.render import formats
 
@@ -235,7 +237,8 @@ class _CountOrAuto(click.ParamType):
     def __init__(self, error: Callable[[], str]) -> None:
         self._error = error
 
-    def convert(self, value, param, ctx):  # noqa: ANN001, ANN201
+    def convert(self, value: Any, param: click.Parameter | None,
+                ctx: click.Context | None) -> int | str:
         if isinstance(value, int) or value == "auto":
             return value
         try:

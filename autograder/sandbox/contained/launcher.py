@@ -320,7 +320,7 @@ def main(argv: list[str]) -> None:
         contain(spec, stage)
         stage[0] = f"exec {command[0]}"
         os.execvp(command[0], command)
-    except BaseException as exc:  # noqa: BLE001 - every failure before the exec is ours
+    except BaseException as exc:  # every failure before the exec is ours
         report = json.dumps({"stage": stage[0], "error": f"{type(exc).__name__}: {exc}"})
         if status_fd is None:
             print(report, file=sys.stderr)

@@ -178,7 +178,7 @@ def _become_program(request: dict, fds: list[int]) -> tuple[str, list[str]]:
         os.environ.update(request["env"])
         os.chdir(request["cwd"])
         contain(request["spec"], stage)
-    except BaseException as exc:  # noqa: BLE001 - every failure before the program is ours
+    except BaseException as exc:  # every failure before the program is ours
         os.write(status, json.dumps({"stage": stage[0],
                                      "error": f"{type(exc).__name__}: {exc}"}).encode())
         os._exit(LAUNCH_FAILED)
