@@ -21,7 +21,7 @@ def test_reference_max_score_is_the_exercise_points(graded):
     assert graded["reference#0"].max_score == 13
 
 
-# A syntax error is refused before any world starts: tests/test_source.py.
+# A syntax error is refused before any world starts: tests/core/test_source.py.
 
 
 def test_crash_at_start_scores_zero_with_its_traceback(graded):

@@ -1,0 +1,269 @@
+"""The launcher between the grader and a student's program: a failure before the exec is
+the grader's, reported as such, never the student's zero; strict isolation works wherever
+the interpreter lives, /tmp included."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+import sysconfig
+import tempfile
+from collections.abc import Iterator
+from pathlib import Path
+from xml.etree import ElementTree
+
+import pytest
+
+from autograder.core.exercise import Limits
+from autograder.grading.run import GRADER_FAULT
+from autograder.sandbox.isolation import (
+    FASTDDS_PROFILE,
+    PROFILE_ENV,
+    Isolation,
+    dds_env,
+    detect,
+)
+from autograder.sandbox.process import (
+    STRICT_WORKDIR_PREFIX,
+    LaunchFailed,
+    reap_recorded,
+    student_process,
+)
+
+REPO = Path(__file__).resolve().parents[2]
+COURSE = REPO / "tests" / "fixtures" / "mini_course"
+SOLUTION = COURSE / "assignments" / "shout" / "solution"
+
+
+def _program(tmp_path: Path, text: str) -> Path:
+    script = tmp_path / "staged" / "program.py"
+    script.parent.mkdir(parents=True)
+    script.write_text(text)
+    return script
+
+
+def test_a_launch_that_cannot_exec_raises_launch_failed(tmp_path, monkeypatch):
+    monkeypatch.setenv("AUTOGRADER_STUDENT_PYTHON", "/nonexistent/python3")
+    process = student_process(_program(tmp_path, "print('ran')\n"), [], Limits(), domain=0,
+                              strict=False, course=COURSE)
+    with pytest.raises(LaunchFailed) as failure:
+        process.start()
+    assert failure.value.stage == "exec /nonexistent/python3"
+    assert "FileNotFoundError" in failure.value.error
+    assert not process.running()
+    assert "ran" not in process.output_text()
+
+
+def test_a_program_that_fails_at_once_is_the_programs_failure(tmp_path):
+    """Exit status 1 from the program itself is not a launch failure: the exec happened."""
+    process = student_process(_program(tmp_path, "raise SystemExit('mine')\n"), [],
+                              Limits(), domain=0, strict=False, course=COURSE)
+    process.start()  # no LaunchFailed: the pipe closed on exec
+    assert process.wait(30) == 1
+    process.stop()
+    assert "mine" in process.output_text()
+
+
+def test_the_program_gets_the_runs_fast_dds_profile_in_its_own_folder(tmp_path):
+    """The student's program reads the run's Fast DDS profile from a copy in its working
+    directory (in strict isolation the grader's package is hidden from it)."""
+    shown = ("import os, pathlib\n"
+             f"path = pathlib.Path(os.environ[{PROFILE_ENV!r}])\n"
+             "print(path.parent == pathlib.Path.cwd(), path.read_text())\n")
+    process = student_process(_program(tmp_path, shown), [], Limits(), domain=0,
+                              strict=False, course=COURSE)
+    process.start()
+    assert process.wait(30) == 0
+    process.stop()
+    assert process.output_text().startswith("True ")
+    assert FASTDDS_PROFILE.read_text() in process.output_text()
+
+
+def test_the_fast_dds_profile_announces_participants_often():
+    """The profile is Fast DDS XML whose default participant announces itself every 0.25 s
+    and 20 times at the start (the file says why), and every process of a run gets it."""
+    ns = {"f": "http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles"}
+    root = ElementTree.parse(FASTDDS_PROFILE).getroot()
+    participant = root.find("f:participant[@is_default_profile='true']", ns)
+    assert participant is not None
+    discovery = participant.find("f:rtps/f:builtin/f:discovery_config", ns)
+    assert discovery.findtext("f:leaseAnnouncement/f:nanosec", namespaces=ns) == "250000000"
+    assert discovery.findtext("f:initialAnnouncements/f:count", namespaces=ns) == "20"
+    for mode in ("basic", "strict"):
+        assert dds_env(Isolation(mode))[PROFILE_ENV] == str(FASTDDS_PROFILE)
+
+
+_SUBSCRIBER = """
+import rclpy
+from geometry_msgs.msg import Twist
+rclpy.init()
+node = rclpy.create_node("acks_subscriber")
+node.create_subscription(Twist, "/cmd_vel", lambda message: None, 10)
+rclpy.spin(node)
+"""
+_PUBLISHER = """
+import json, time
+import rclpy
+from geometry_msgs.msg import Twist
+from rclpy.duration import Duration
+rclpy.init()
+node = rclpy.create_node("acks_publisher")
+publisher = node.create_publisher(Twist, "/cmd_vel", 10)
+deadline = time.monotonic() + 20
+while publisher.get_subscription_count() < 1 and time.monotonic() < deadline:
+    time.sleep(0.01)
+acked = []
+for _ in range(3):
+    publisher.publish(Twist())
+    acked.append(publisher.wait_for_all_acked(Duration(seconds=1.5)))
+print(json.dumps(acked))
+"""
+
+
+def test_a_reliable_stop_is_acknowledged_within_the_wait(tmp_path):
+    """A reliable writer is acknowledged within a ``wait_for_all_acked`` that a clean exit
+    does (error_handling's README: 1 s). Acks come only after the writer's heartbeat: with
+    Fast DDS's default of one every 3 s, three waits in a row cannot all succeed."""
+    from autograder.sandbox.domains import hold_domain
+
+    with hold_domain() as lock:  # both launched as a student's program is, profile and all
+        subscriber, publisher = (
+            student_process(_program(tmp_path / name, text), [], Limits(), domain=lock.domain,
+                            strict=False, course=COURSE)
+            for name, text in (("subscriber", _SUBSCRIBER), ("publisher", _PUBLISHER)))
+        subscriber.start()
+        try:
+            publisher.start()
+            assert publisher.wait(60) == 0, publisher.output_text()
+            publisher.stop()
+        finally:
+            subscriber.stop()
+    assert json.loads(publisher.output_text().splitlines()[-1]) == [True, True, True], \
+        publisher.output_text()
+
+
+def test_user_tasks_counts_threads_as_rlimit_nproc_does(tmp_path):
+    """Without a uid of its own, a student's RLIMIT_NPROC is what its user already runs plus
+    its own allowance, so the count is of threads (as RLIMIT_NPROC counts), by real uid."""
+    from autograder.sandbox.contained.launcher import user_tasks
+
+    def process(pid: str, uids: str, threads: int | None) -> None:
+        (tmp_path / pid).mkdir()
+        lines = ["Name:\tpython3", f"Uid:\t{uids}"] + \
+            ([f"Threads:\t{threads}"] if threads is not None else [])
+        (tmp_path / pid / "status").write_text("\n".join(lines) + "\n")
+
+    process("10", "1000\t1000\t1000\t1000", 3)
+    process("11", "1000\t0\t0\t0", 4)  # real uid 1000, set-uid root: counted
+    process("12", "0\t1000\t1000\t1000", 9)  # real uid root: not counted
+    process("13", "1000\t1000\t1000\t1000", None)  # a short status: skipped
+    (tmp_path / "14").mkdir()  # gone between listing and reading
+    (tmp_path / "self").mkdir()
+    assert user_tasks(1000, str(tmp_path)) == 7
+    # Live: this process's own threads are among its user's.
+    assert user_tasks(os.getuid()) >= len(os.listdir("/proc/self/task"))
+
+
+@pytest.mark.slow
+def test_a_grader_fault_is_exit_3_never_a_students_zero(tmp_path):
+    """With the launcher unable to exec the interpreter, `grade` says the autograder
+    failed (exit 3), marks no test as the student's failure, and still writes results."""
+    env = dict(os.environ, AUTOGRADER_COURSE=str(COURSE),
+               AUTOGRADER_STUDENT_PYTHON="/nonexistent/python3")
+    results = tmp_path / "results.json"
+    run = subprocess.run([sys.executable, "-m", "autograder.cli", "grade", "shout",
+                          str(SOLUTION), "--results", str(results)],
+                         capture_output=True, text=True, env=env, timeout=300)
+    assert run.returncode == 3, run.stdout + run.stderr
+    assert "The autograder failed, tell your instructor." in run.stdout
+    data = json.loads(results.read_text())
+    assert data["grader_error"] == GRADER_FAULT
+    assert {t["status"] for t in data["tests"]} == {"error"}
+    assert "the launcher failed at exec /nonexistent/python3" in run.stdout  # the detail
+
+
+def _venv_under_tmp() -> Path:
+    """A venv in /tmp whose packages are this one's (a .pth file), made in a second."""
+    folder = Path(tempfile.mkdtemp(prefix="autograder-venv-", dir="/tmp"))
+    os.chmod(folder, 0o755)
+    venv = folder / "venv"
+    base = getattr(sys, "_base_executable", sys.executable)
+    subprocess.run([base, "-m", "venv", "--without-pip", str(venv)], check=True)
+    site = Path(sysconfig.get_path("purelib", vars={"base": str(venv)}))
+    (site / "parent.pth").write_text(sysconfig.get_path("purelib") + "\n")
+    return venv
+
+
+@pytest.fixture(scope="module")
+def tmp_setup() -> Iterator[tuple[Path, Path]]:
+    """A venv and a copy of the course, both under /tmp, as a clone in /tmp has them."""
+    if not detect().strict:
+        pytest.skip(f"needs strict isolation: {detect().reason}")
+    venv = _venv_under_tmp()
+    course = Path(tempfile.mkdtemp(prefix="autograder-course-", dir="/tmp")) / "course"
+    shutil.copytree(COURSE, course)
+    os.chmod(course.parent, 0o755)
+    yield venv, course
+    shutil.rmtree(venv.parent, ignore_errors=True)
+    shutil.rmtree(course.parent, ignore_errors=True)
+
+
+def _grade_from(venv: Path, course: Path, submission: Path, out: Path) -> tuple[dict, str]:
+    """Grade with the venv's Python; the results and the JUnit XML (it holds the log)."""
+    env = dict(os.environ, AUTOGRADER_COURSE=str(course), PYTHONPATH=str(REPO))
+    junit = out.with_suffix(".xml")
+    run = subprocess.run([str(venv / "bin" / "python"), "-m", "autograder.cli", "grade",
+                          "shout", str(submission), "--results", str(out), "--junit",
+                          str(junit)], capture_output=True, text=True, env=env, timeout=300)
+    assert run.returncode == 0, run.stdout + run.stderr
+    return json.loads(out.read_text()), junit.read_text()
+
+
+@pytest.mark.slow
+def test_strict_isolation_with_the_venv_and_the_course_under_tmp(tmp_setup, tmp_path):
+    venv, course = tmp_setup
+    data, _log = _grade_from(venv, course, course / "assignments/shout/solution",
+                             tmp_path / "results.json")
+    assert data["isolation"]["mode"] == "strict"
+    assert (data["score"], data["max_score"]) == (3, 3)
+    _data, log = _grade_from(venv, course, REPO / "tests/submissions/hostile/reads_secrets",
+                             tmp_path / "secrets.json")
+    assert "SECRETS FOUND: 0" in log
+
+
+@pytest.mark.skipif(os.geteuid() != 0 or not shutil.which("setpriv")
+                    or not shutil.which("unshare"), reason="needs root, setpriv and unshare")
+def test_refused_namespaces_are_named_as_the_reason():
+    """In an unprivileged container (no CAP_SYS_ADMIN) the student still gets a user of its
+    own (isolation by user), and the reason says namespaces were refused, not that the venv
+    is unreadable."""
+    code = "from autograder.sandbox.isolation import detect; i = detect(); print(i.mode, i.reason)"
+    run = subprocess.run(["setpriv", "--bounding-set=-sys_admin", "--inh-caps=-sys_admin",
+                          sys.executable, "-c", code], capture_output=True, text=True,
+                         env=dict(os.environ, PYTHONPATH=str(REPO)), timeout=120)
+    assert run.stdout.strip() == ("user namespaces are not allowed here (an unprivileged "
+                                  "container?)"), run.stderr
+
+
+def test_reaping_a_record_removes_the_strict_folder_it_names_and_no_other(tmp_path):
+    """A run killed before its fixtures stop the program (the time limit, a wait that
+    raised) leaves the strict folder in the temporary folder: the parent's reaping, from the
+    run's report, removes it; a record naming any other folder removes nothing."""
+    strict = Path(tempfile.mkdtemp(prefix=STRICT_WORKDIR_PREFIX))
+    (strict / ".ros").mkdir()
+    (strict / "program.py").write_text("print()\n")
+    elsewhere = tmp_path / f"{STRICT_WORKDIR_PREFIX}not-in-tmp"
+    elsewhere.mkdir()
+    other = Path(tempfile.mkdtemp(prefix="not-a-student-"))
+    try:
+        for folder in (elsewhere, other, strict):
+            # pid 0 would signal our own group: a pid that is surely gone instead.
+            reap_recorded({"pid": 2 ** 22 + 1, "cgroups": [], "workdir": str(folder)})
+        assert not strict.exists()
+        assert elsewhere.is_dir() and other.is_dir()
+    finally:
+        shutil.rmtree(strict, ignore_errors=True)
+        shutil.rmtree(other, ignore_errors=True)
