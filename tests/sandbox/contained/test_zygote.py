@@ -21,7 +21,7 @@ from autograder.sandbox import process as process_module
 from autograder.sandbox.contained.zygote import ForkedProcess
 from autograder.sandbox.process import LaunchFailed, StudentProcess, student_process
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[3]
 
 SELF = """\
 import os, sys
