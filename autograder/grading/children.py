@@ -117,6 +117,22 @@ def bytecode_env(env: dict[str, str]) -> dict[str, str]:
     return env
 
 
+# What the grader's environment may say to any pytest: options (-x stops at the first
+# failed test, and with it the score), plugins to load, whether to load installed ones.
+_PYTEST_VARIABLES = ("PYTEST_ADDOPTS", "PYTEST_PLUGINS", "PYTEST_DISABLE_PLUGIN_AUTOLOAD",
+                     "PYTEST_DEBUG", "PYTEST_CURRENT_TEST", "PYTEST_VERSION")
+
+
+def pytest_env(env: dict[str, str]) -> dict[str, str]:
+    """``env`` for a child pytest: the same tests, options and plugins whoever grades.
+    Nothing of the caller's pytest settings reaches it, and no installed plugin loads but
+    ours (named with ``-p``): a pytest-randomly would reorder the tests, a rerun plugin
+    grade twice, an ``-x`` in ``PYTEST_ADDOPTS`` stop at the first failure."""
+    env = {k: v for k, v in env.items() if k not in _PYTEST_VARIABLES}
+    env["PYTEST_DISABLE_PLUGIN_AUTOLOAD"] = "1"
+    return env
+
+
 @contextlib.contextmanager
 def started(prefix: Sequence[str], settings: RunSettings, targets: Sequence[str],
             folder: Path, rootdir: Path, lock: DomainLock, *,
@@ -133,10 +149,10 @@ def started(prefix: Sequence[str], settings: RunSettings, targets: Sequence[str]
                                    lifeline_fd=life_read, domain=lock.domain)
     command = [
         *prefix, sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
-        "--rootdir", str(rootdir), "--basetemp", str(folder / "pytest"),
-        "--autograder-settings", settings.to_json(), *targets,
+        "-p", "autograder.plugin", "--rootdir", str(rootdir), "--basetemp",
+        str(folder / "pytest"), "--autograder-settings", settings.to_json(), *targets,
     ]
-    env = bytecode_env(dict(os.environ))
+    env = pytest_env(bytecode_env(dict(os.environ)))
     if not zygote:
         env["AUTOGRADER_ZYGOTE"] = "0"
     log_path = folder / "pytest.log"
