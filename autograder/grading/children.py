@@ -26,7 +26,9 @@ from autograder.core.report import RawReport, RawTest
 from autograder.core.settings import RunSettings
 from autograder.grading.footprint import Footprint
 from autograder.sandbox.domains import DomainLock
+from autograder.sandbox.isolation import student_uid
 from autograder.sandbox.process import reap_recorded
+from autograder.sandbox.sweep import sweep_user
 
 Progress = Callable[[RawTest], None]
 
@@ -48,6 +50,8 @@ class Child:
     key: bytes
     log_path: Path
     launched: float  # monotonic, the same clock in both processes
+    # The student's own user in this child's runs (strict and user isolation), else None.
+    uid: int | None = None
     timed_out: bool = False
     stopped: bool = False  # something stopped it (SIGSTOP): what it reports is not trusted
     # The report's tests as last read, and the file's (inode, size, mtime) then.
@@ -167,7 +171,8 @@ def started(prefix: Sequence[str], settings: RunSettings, targets: Sequence[str]
         os.close(life_read)
         with os.fdopen(key_write, "wb") as pipe:
             pipe.write(key)
-        yield Child(process, report_path, key, log_path, launched)
+        yield Child(process, report_path, key, log_path, launched,
+                    student_uid(lock.domain) if settings.own_user else None)
     finally:
         os.close(life_write)
 
@@ -251,6 +256,10 @@ def abandon(running: Sequence[Child], grace: float = 10.0) -> None:
             child.process.wait(5.0)
         for process in report.read(child.report_path, child.key).processes:
             reap_recorded(process)
+        # A program the child was starting when it was killed has no record: where the
+        # student has a user of its own, that user's sweep ends it all the same.
+        if child.uid is not None:
+            sweep_user(child.uid)
 
 
 def end(child: Child) -> Ended:

@@ -123,7 +123,7 @@ def _watch_lifeline(fd: int, reporter: GradingReporter) -> None:
                 pass
         from autograder.sandbox.process import reap_recorded
 
-        for process in list(reporter.data["processes"]):
+        for process in reporter.ending():
             reap_recorded(process)
         os.killpg(os.getpgrp(), signal.SIGKILL)
 
