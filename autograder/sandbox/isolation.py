@@ -7,9 +7,8 @@ as a user of its own (uid ``STUDENT_UID_BASE + domain``), in a mount namespace w
 course's hidden tests, solutions and project tests are covered by empty read-only
 filesystems, with a size-limited tmpfs as working directory.  Fast DDS then speaks UDP
 only: its shared-memory segments, created by root, are not writable by the student's
-user and traffic silently stops (measured), and ``ROS_AUTOMATIC_DISCOVERY_RANGE=
-LOCALHOST`` also cut the student off from a root peer (measured), while the namespace
-already confines discovery to loopback.
+user, and ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST`` would cut the student off from a
+root peer; the namespace already confines discovery to loopback.
 
 **User** (the grader runs as root where namespaces are refused: Gradescope's container, a
 Kubernetes pod, both without ``CAP_SYS_ADMIN``): the student still runs as a user of its
@@ -18,8 +17,8 @@ default. What namespaces did is done by ownership and mode: the course's protect
 are closed to other users (:func:`close_to_others`), the student's folder is its own
 (0700), and whatever its user leaves is swept (:mod:`autograder.sandbox.sweep`). Fast DDS
 speaks UDP on loopback only (:data:`LOOPBACK_PROFILE`): with shared memory the student's
-user cannot use segments root made, and ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST`` cut a
-root participant off from another user's (both measured). The program keeps the network
+user cannot use segments root made, and ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST`` cuts a
+root participant off from another user's. The program keeps the network
 and sees the machine's processes: no namespace can take them away here.
 
 **Basic** (anything else: an ordinary user; ``AUTOGRADER_ISOLATION=basic``): process
