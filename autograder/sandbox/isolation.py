@@ -97,18 +97,18 @@ def detect() -> Isolation:
     elif shutil.which("unshare") is None:
         strict = Isolation("user", N_("the unshare command (util-linux) is missing"))
     else:
-        strict = _probe(Isolation("strict"))
+        strict = _check(Isolation("strict"))
         if strict.mode == "strict":
             return strict
     # No namespaces: a user of its own all the same, if a test program runs as one.
-    own = _probe(Isolation("user", strict.reason, strict.detail))
+    own = _check(Isolation("user", strict.reason, strict.detail))
     if own.mode == "user":
         return own
     return Isolation("basic", own.reason, " / ".join(d for d in (strict.detail, own.detail)
                                                       if d))
 
 
-def _probe(isolation: Isolation) -> Isolation:
+def _check(isolation: Isolation) -> Isolation:
     """``isolation`` if a test program runs in it as a student's does; else basic, why."""
     command = [*run_prefix(isolation),
                *module_command("autograder.sandbox.startup_check", [isolation.mode])]
@@ -125,11 +125,11 @@ def _probe(isolation: Isolation) -> Isolation:
             if isinstance(exc, subprocess.TimeoutExpired):
                 return Isolation("basic", _could_not(isolation), "no answer within 120 s")
             raise
-    probe = subprocess.CompletedProcess(command, running.returncode, out, err)
-    if probe.returncode == 0:
+    checked = subprocess.CompletedProcess(command, running.returncode, out, err)
+    if checked.returncode == 0:
         return isolation
-    detail = " / ".join((probe.stdout + probe.stderr).strip().splitlines()[-3:])
-    if probe.stderr.startswith("unshare:"):  # the namespaces themselves were refused
+    detail = " / ".join((checked.stdout + checked.stderr).strip().splitlines()[-3:])
+    if checked.stderr.startswith("unshare:"):  # the namespaces themselves were refused
         return Isolation("basic", N_("namespaces are not allowed here (an unprivileged "
                                      "container?)"), detail)
     return Isolation("basic", _could_not(isolation), detail)
