@@ -8,7 +8,6 @@ file); 3 when the autograder itself failed (:mod:`autograder.cli.exits`).
 from __future__ import annotations
 
 import json
-import shutil
 import signal
 from collections.abc import Callable
 from pathlib import Path
@@ -190,20 +189,9 @@ def _quizzes() -> list:
 def start(exercise: str, directory: Path | None) -> None:
     """Copy an exercise's starter code, README and own world file into DIRECTORY (default:
     the exercise id)."""
-    found = _exercise(exercise)
-    target = directory or Path(found.id)
-    target.mkdir(parents=True, exist_ok=True)
-    copied = []
-    # A world kept in the exercise's folder goes too: the README's hand run names it there.
-    world = found.folder / found.world
-    own_world = [world] if world.suffix in (".yaml", ".yml") and world.is_file() else []
-    for source in (found.starter, *sorted(found.folder.glob("README*.md")), *own_world):
-        dest = target / source.name
-        if dest.exists():
-            raise UsageProblem(_("{path} already exists; not overwriting your work").format(
-                path=dest))
-        shutil.copy2(source, dest)
-        copied.append(dest)
+    from autograder.commands.start import start as copy_starter
+
+    found, target, copied = copy_starter(exercise, directory)
     for path in copied:
         click.echo(_("created {path}").format(path=path))
     click.echo(_("Next: edit {file}, then run `autograder check {exercise} {file}`").format(
