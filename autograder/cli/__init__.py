@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any, TypeVar
 import click
 
 from autograder import __version__
+from autograder.cli import click_words
 from autograder.cli.exits import GraderFault, UsageProblem, report_problems
 from autograder.core.dumpable import not_dumpable
 from autograder.core.errors import ContentError, GraderError, UsageError
@@ -24,6 +25,8 @@ from autograder.i18n import LANGUAGES, _, ngettext, set_language
 
 if TYPE_CHECKING:
     from autograder.core.exercise import Exercise
+
+click_words.speak()  # click's own words (usage errors) in the active language, from here on
 
 F = TypeVar("F", bound=Callable[..., Any])
 

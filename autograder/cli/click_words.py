@@ -40,7 +40,8 @@ WORDS = (
 
 
 def speak() -> None:
-    """Make click translate with our catalogs (idempotent; English is unchanged)."""
+    """Make click translate with our catalogs, in whatever language is active when it
+    speaks (idempotent; English is unchanged)."""
     for module in _MODULES:
         module._ = _  # type: ignore[attr-defined]
         if hasattr(module, "ngettext"):
