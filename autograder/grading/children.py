@@ -60,9 +60,8 @@ class Child:
 
     def reported_tests(self) -> list[RawTest]:
         """The tests as the report says now, read again only when the file changed: it is
-        replaced whole on each write (a new inode), and unchanged most of the time. With
-        the world's recordings in it, a report of a few hundred KB parsed four times a
-        second cost error_handling's grading 0.7 CPU-seconds."""
+        replaced whole on each write (a new inode), and unchanged most of the time, while
+        parsing it (the world's recordings in it) is not cheap."""
         try:
             stat = self.report_path.stat()
         except OSError:

@@ -216,8 +216,8 @@ def _run(exercise: Exercise, submission: Path | None, plan: _Plan,
     raw report. Each child gets its :class:`~autograder.core.settings.RunSettings` as one
     document (see :mod:`autograder.grading.children`). A single child forks students'
     programs from a zygote (it runs every module's, and a batch's CPU is what it saves);
-    children at once exec them (a zygote each would add about 20 MB each to the grading's
-    memory, for a start or two a child)."""
+    children at once exec them (a zygote each costs more memory than a start or two
+    saves: docs/contributors/design.md, "Warm starts")."""
     targets = plan.targets(len(locks))
     settings = RunSettings(
         domains=tuple(lock.domain for lock in locks),

@@ -27,6 +27,7 @@ from autograder.core.output_budget import (
 from autograder.core.report import RawTest
 from autograder.core.results import exact
 from autograder.i18n import _
+from autograder.plugin.markers import marker_problem
 from autograder.plugin.msgtypes import type_note
 from autograder.plugin.stash import credit_key, evidence_key, settings_key
 from autograder.plugin.timing import Timing, module_of
@@ -223,8 +224,6 @@ def peak_memory() -> dict[str, float]:
 
 def _points(item: pytest.Item) -> Any:
     """The points a test is worth (its ``points`` marker, else 1)."""
-    from autograder.plugin import marker_problem
-
     if marker_problem(item) is not None:
         return 1  # the test errs at setup, naming the problem
     marker = item.get_closest_marker("points")
