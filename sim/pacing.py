@@ -403,7 +403,7 @@ class Pacer:
                 pause = policy.poll_interval
             then = now
             if hold.working:
-                pass
+                pass  # its share, or hold_cap, ends this
             elif hold.deaf:
                 if now >= deafness and not self._in_flight():
                     return "unheard"
