@@ -404,6 +404,8 @@ class Pacer:
             then = now
             if hold.working:
                 pass  # its share, or hold_cap, ends this
+            elif not hold.still:
+                pass  # one reading showed them done: a second must agree
             elif hold.deaf:
                 if now >= deafness and not self._in_flight():
                     return "unheard"
@@ -456,6 +458,7 @@ class _Hold:
     states: dict[int, ProcessState] = field(default_factory=dict)  # the last reading
     late: bool = False  # an idle process had not heard the tick yet
     awaited: bool = False  # the world's middleware was still taking messages in
+    still: bool = False  # the last two readings agree that none of them works
 
     def read(self, states: dict[int, ProcessState]) -> bool:
         """Take a reading; True if every busy process waited for a CPU since the last."""
@@ -463,7 +466,17 @@ class _Hold:
         for pid, state in states.items():
             self.heard[pid] = self.heard[pid] or (not state.exists or state.busy
                                                   or state.cpu_ns > self.baseline[pid])
+        # A reading of a process is one thread after another, not one instant: a thread
+        # woken by another after we read it, the other gone to sleep before we read it,
+        # reads idle.  It will have run, or be runnable, by the next reading.
+        self.still = all(not state.exists or self._spent(pid) or (
+            pid in previous and not previous[pid].busy and not state.busy
+            and previous[pid].cpu_ns == state.cpu_ns) for pid, state in states.items())
         return _starved(previous, states)
+
+    def _spent(self, pid: int) -> bool:
+        """Process ``pid`` has used its share since the tick (it is let go, busy or not)."""
+        return self.states[pid].cpu_ns - self.baseline[pid] >= self.share_ns[pid]
 
     @property
     def working(self) -> bool:

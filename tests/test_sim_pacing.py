@@ -359,6 +359,27 @@ def test_held_seconds_count_holds_past_the_deadline_only() -> None:
     assert starved.pacer.held_seconds == pytest.approx(3 * (2.0 - 0.02), abs=0.003)
 
 
+def test_a_process_read_idle_once_is_read_again() -> None:
+    """One reading of a process goes thread by thread, so a thread woken by another just
+    after it was read, its waker asleep by the time it is read, makes a working process
+    read idle once. The tick goes only when a second reading agrees."""
+    clock = FakeClock()
+
+    def read(pid: int) -> ProcessState:
+        t = clock.now - clock.ticks[-1] if clock.ticks else 0.0
+        before = len(clock.ticks) * 0.02  # CPU seconds of the ticks before
+        if 0.0018 <= t < 0.0023:  # the reading that falls between waker and woken
+            return ProcessState(busy=False, cpu_ns=round((before + 0.0018) * 1e9))
+        used = min(t, 0.0018) + max(0.0, min(t, 0.01) - 0.0023)
+        return ProcessState(busy=t < 0.01, cpu_ns=round((before + used) * 1e9))
+
+    run = Run(Pacer(DT, 1.0, clock=clock, read_process=read), clock)
+    run.pacer.watch(4242)
+    run.ticks_for(3)
+    assert run.pacer.counts == {"idle": 3}
+    assert run.pacer.longest_hold == pytest.approx(0.0105, abs=0.001)  # done at 10 ms
+
+
 def test_every_watched_process_must_be_done() -> None:
     clock = FakeClock()
     idle_soon, computing = FakeProcess(clock, idle_at=clock.now), FakeProcess(clock)
