@@ -17,9 +17,10 @@ design notes, "Pacing"):
 * **Wall deadline.**  A tick is given ``steps * dt / r`` wall seconds; a late tick moves
   the schedule (no catch-up burst), so sim time just runs slower.
 * **Hold.**  With watched processes, the next tick also waits until each has *heard* the
-  tick and is idle, or has used its CPU share since the tick (``cpu_budget`` and what it
-  banked in its reserve), so a process that waits for a CPU holds sim time back and one
-  that busy-loops only slows it.  A process hears a tick when its CPU time grows or it
+  tick and is idle (two readings agreeing: one reading is thread after thread, not an
+  instant), or has used its CPU share since the tick (``cpu_budget`` and what it banked
+  in its reserve), so a process that waits for a CPU holds sim time back and one that
+  busy-loops only slows it.  A process hears a tick when its CPU time grows or it
   runs after the tick went out; one that heard the tick before is waited for to hear this
   one, up to ``hear_timeout`` while the kernel holds no packet it has not yet delivered.
   Then the world's own middleware must have taken in what the processes sent, up to
