@@ -69,7 +69,7 @@ class NodeRun:
         """The node to wait for: the exercise's, or any new node for a plain file."""
         return self.exercise.node if self.exercise is not None else None
 
-    def bridge_options(self) -> dict[str, Any]:
+    def pacing_options(self) -> dict[str, Any]:
         return {"cpu_budget": self.exercise.cpu_budget} if self.exercise is not None else {}
 
     def start(self, bridge: SimBridge) -> None:
