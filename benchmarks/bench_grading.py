@@ -55,12 +55,12 @@ def main() -> None:
                                                        module_jobs=args.module_jobs))
             walls.append(time.monotonic() - began)
             cpus.append(share * walls[-1])
-            startups += result.data.get("startup_seconds", [])
+            startups += list(result.startup_seconds)
             scores.add(f"{result.score}/{result.max_score}")
-            timings.setdefault(exercise.id, []).append(result.data.get("timing", {}))
-            if result.data.get("memory"):
-                memory.setdefault(exercise.id, []).append(result.data["memory"])
-            for module in result.data.get("pacing", {}).values():
+            timings.setdefault(exercise.id, []).append(result.timing)
+            if result.memory:
+                memory.setdefault(exercise.id, []).append(result.memory)
+            for module in result.pacing.values():
                 ticks.update({k: v for k, v in module.items() if k in ("idle", "budget", "cap")})
         startup = f"{statistics.median(startups):.2f} s" if startups else "-"
         cpu_medians[exercise.id] = statistics.median(cpus)

@@ -50,7 +50,7 @@ STAGES = ("process start + python", "rclpy import", "init + node", "discovery", 
 def one_start(graph: object, exercise: object, domain: int, folder: Path,
               strict: bool) -> list[float]:
     """Start the program once; the seconds of each stage (see :data:`STAGES`)."""
-    from autograder.sandbox.graph import node_endpoints
+    from autograder.plugin.graph import node_endpoints
     from autograder.sandbox.process import student_process
     from sim.procstate import read_process_state
 

@@ -2,8 +2,8 @@
 
 import os
 
+from content.i18n import set_language
 from sim.cli import sim_cli
-from sim.i18n import set_language
 
 if __name__ == "__main__":
     # The language the platform prints in (README, Settings); `autograder` reads it too.

@@ -18,14 +18,17 @@ from typing import TYPE_CHECKING, Any, Protocol
 import click
 from click.core import ParameterSource
 
-from sim.content import ContentError
-from sim.i18n import _
+from content import ContentError
+from content.i18n import _
 from sim.keyboard import Command
 from sim.pacing import DEFAULT_CLOCK_HZ
 from sim.worldfile import load_world, title_of, world_names, world_path
 
 if TYPE_CHECKING:
+    from sim.bag import BagRecorder
     from sim.bridge import SimBridge
+    from sim.drive import Driver
+    from sim.worldfile import WorldSpec
 
 COMPANION = "sim.run.companion"
 """Key of the :class:`Companion` ``sim run`` starts with the world, in ``ctx.meta``."""
@@ -58,7 +61,7 @@ class WorldFileError(click.ClickException):
     exit_code = 2
 
 
-def _load(name_or_path: str):  # noqa: ANN202 - WorldSpec, imported lazily below
+def _load(name_or_path: str) -> WorldSpec:
     try:
         return load_world(name_or_path)
     except ContentError as exc:
@@ -133,7 +136,7 @@ def _domain(given: int | None) -> int:
     return int(os.environ.get("ROS_DOMAIN_ID", "0")) if given is None else given
 
 
-def run_world(spec, *, rtf: float, duration: float | None, domain: int,  # noqa: ANN001
+def run_world(spec: WorldSpec, *, rtf: float, duration: float | None, domain: int,
               seed: int | None = None, record: Path | None = None,
               svg: Path | None = None, clock_hz: float = DEFAULT_CLOCK_HZ,
               bag: Path | None = None, companion: Companion | None = None) -> str:
@@ -283,7 +286,7 @@ def drive(topic: str, command: Command, *, seconds: float | None, rate: float = 
         rclpy.try_shutdown(context=ctx)
 
 
-def _drive_by_keys(driver, seconds: float | None) -> None:  # noqa: ANN001 - sim.drive.Driver
+def _drive_by_keys(driver: Driver, seconds: float | None) -> None:
     import sys
 
     from sim.keyboard import apply_key, raw_terminal, read_keys
@@ -309,7 +312,7 @@ def _drive_by_keys(driver, seconds: float | None) -> None:  # noqa: ANN001 - sim
         click.echo(err=True)  # off the status line
 
 
-def _recorder(folder: Path, bridge, world: str):  # noqa: ANN001, ANN202 - SimBridge, BagRecorder
+def _recorder(folder: Path, bridge: SimBridge, world: str) -> BagRecorder:
     """A bag recorder tapping ``bridge``; None (and a warning) if the bag cannot be made."""
     from sim.bag import BagRecorder
 
@@ -325,7 +328,7 @@ def _recorder(folder: Path, bridge, world: str):  # noqa: ANN001, ANN202 - SimBr
     return recorder
 
 
-def _record_drivers(bridge) -> None:  # noqa: ANN001 - SimBridge
+def _record_drivers(bridge: SimBridge) -> None:
     """A recorded hand run also records the velocity commands sent to other nodes: what
     ``sim drive --topic /agent/cmd_vel`` gives the student's node, beside the /cmd_vel
     that node sends on (every Twist or TwistStamped topic on the graph, found as it
@@ -339,7 +342,7 @@ def _record_drivers(bridge) -> None:  # noqa: ANN001 - SimBridge
             bridge.listen(topic, found)
 
 
-def _warn_mismatches(bridge, warned: set[object]) -> None:  # noqa: ANN001
+def _warn_mismatches(bridge: SimBridge, warned: set[object]) -> None:
     """Say once of each publisher on /cmd_vel whose type the robot does not take."""
     from sim.cmdvel import world_warning
 
@@ -349,7 +352,7 @@ def _warn_mismatches(bridge, warned: set[object]) -> None:  # noqa: ANN001
             click.echo(world_warning(mismatch), err=True)
 
 
-def _summary(spec, bridge, effective: float) -> str:  # noqa: ANN001
+def _summary(spec: WorldSpec, bridge: SimBridge, effective: float) -> str:
     samples, collisions = bridge.recording.snapshot()
     x, y, theta = bridge.world.pose
     ox, oy, otheta = bridge.sim.odometry.pose

@@ -15,7 +15,7 @@ from typing import Any
 from geometry_msgs.msg import Twist, TwistStamped
 from rclpy.node import Node
 
-from sim.i18n import _
+from content.i18n import _
 from sim.msgdefs import type_name
 
 CMD_VEL_TOPIC = "/cmd_vel"

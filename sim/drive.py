@@ -13,6 +13,7 @@ from collections.abc import Callable
 
 from geometry_msgs.msg import Twist, TwistStamped
 from rclpy.context import Context
+from rclpy.duration import Duration
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
@@ -130,7 +131,5 @@ class Driver:
         self._publisher.publish(msg)
 
 
-def _duration(seconds: float):  # noqa: ANN202 - rclpy.duration.Duration
-    from rclpy.duration import Duration
-
+def _duration(seconds: float) -> Duration:
     return Duration(nanoseconds=int(seconds * 1e9))

@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from sim.i18n import _
+from content.i18n import _
 
 if TYPE_CHECKING:
     from sim.lidar import Lidar

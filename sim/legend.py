@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from sim.i18n import _, get_language
+from content.i18n import _, get_language
 
 FONT = 0.13  # m, unzoomed: 13 px at the picture's 100 px per metre
 ROW = 0.3  # m between rows

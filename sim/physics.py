@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 import pymunk
 
-from sim.i18n import N_, NP_, _, pgettext
+from content.i18n import N_, NP_, _, pgettext
 from sim.worldfile import ROBOT_RADIUS, Box, Circle, WorldSpec
 
 ROBOT_MASS = 1.0

@@ -13,7 +13,7 @@ import math
 from collections.abc import Sequence
 from html import escape
 
-from sim.i18n import _
+from content.i18n import _
 from sim.legend import legend_height, legend_svg
 from sim.physics import box_corners, describe
 from sim.recorder import Recording

@@ -17,9 +17,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, Any, Literal
 
-from sim.content import ContentError, Document, build, load_document
+from content import ContentError, Document, build, load_document
+from content.i18n import _, pgettext
 from sim.faultkinds import KINDS, kind_names
-from sim.i18n import _, pgettext
 
 WORLDS_DIR = Path(__file__).resolve().parent / "worlds"
 TITLE_CONTEXT = "world"

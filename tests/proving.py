@@ -319,14 +319,13 @@ def diagnosis(result: RunResult) -> dict[str, Any]:
     """What a failed proof prints of a grading: what each lost test said and measured, how
     the world paced itself, where the time went (a verdict that changed under load says
     why)."""
-    charts = {t.name: t.data["charts"] for t in result.tests
-              if t.status != "passed" and t.data.get("charts")}
+    charts = {t.name: t.charts for t in result.tests if t.status != "passed" and t.charts}
     return {"lost": failures(result), "grader_error": result.grader_error,
             "grader_details": result.grader_details[-2000:],
             # What the lost tests measured (e.g. when each rate report came), so a verdict
             # that changed only now and then can be read from CI's log.
             **({"charts": charts} if charts else {}),
-            **{key: result.data[key] for key in ("pacing", "timing") if key in result.data}}
+            **{key: getattr(result, key) for key in ("pacing", "timing") if getattr(result, key)}}
 
 
 _BOTH_TYPES = (re.compile(r"geometry_msgs/msg/Twist\b"),

@@ -14,10 +14,10 @@ import pytest
 from click.testing import CliRunner
 
 from autograder.cli import main
+from autograder.cli.quiz import quiz_cli
 from autograder.core.results import RunResult, TestResult
 from autograder.i18n import get_language, set_language, translations
-from autograder.quiz.cli import quiz_cli
-from autograder.quiz.localize import LRI, PDI, Text, markdown_inline, plain, rich, sentence
+from autograder.i18n.text import LRI, PDI, Text, markdown_inline, plain, rich, sentence
 from autograder.render.html import to_html
 from autograder.render.terminal import RLM, for_terminal, rtl_notice, to_terminal
 from sim.physics import Contact, describe
@@ -124,11 +124,11 @@ def test_check_in_urdu_marks_lines_and_points_to_the_report(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     from autograder.core.report import RawTest
 
-    def fake_grade(exercise, submission, *, progress=None, **_kw):  # noqa: ANN001, ANN202
+    def fake_grade(exercise, submission, *, progress=None, **_kw):
         progress(RawTest("t.py::test_starts", "test_starts", "node شروع ہوتا ہے", 1,
                          "visible", "all", True, "passed"))
         run = _urdu_run()
-        started = dataclasses.replace(run.tests[0], data={"nodeid": "t.py::test_starts"})
+        started = dataclasses.replace(run.tests[0], nodeid="t.py::test_starts")
         return dataclasses.replace(run, lang=get_language(), tests=(started, *run.tests[1:]))
 
     monkeypatch.setattr("autograder.grading.run.grade", fake_grade)
@@ -221,7 +221,7 @@ def test_urdu_report_has_no_english_collisions_or_world_names(urdu_catalog: Path
         "test_b.py": Recording("empty_room", samples, []).to_dict(),
     }
     page = to_html(RunResult(run.kind, run.id, run.title, run.tests, lang="ur",
-                             data={"recordings": recordings}))
+                             recordings=recordings))
     for english in ("wall 3", "box 0", "box 1", "circle 2", "Room with obstacles",
                     "Empty room"):
         assert english not in page, english
@@ -235,7 +235,7 @@ def test_a_programs_output_in_a_message_stays_left_to_right_line_by_line() -> No
     """An Urdu message that ends with the program's output: the sentence is right to left,
     the traceback is kept line by line in a left-to-right block (folded into the sentence
     it read backwards)."""
-    from autograder.quiz.localize import with_output
+    from autograder.i18n.text import with_output
 
     message = ("نوڈ کا پروسیس ختم ہو گیا۔ اس کی آخری سطریں:\n"
                'Traceback (most recent call last):\n  File "avoider.py", line 55\n'

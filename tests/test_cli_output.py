@@ -64,7 +64,7 @@ class Run:
 
 def _marked(test: dict, lang: str) -> str:
     """A test's label as its line shows it: with the core mark of its language."""
-    from autograder.quiz.localize import using_language
+    from autograder.i18n.text import using_language
     from autograder.render.verdict import core_label
 
     with using_language(lang):

@@ -56,7 +56,7 @@ def course() -> Iterator[Path]:
     checkout would be: the bundle is built from it."""
     folder = world_readable_folder("autograder-course-")
     for name in ("pyproject.toml", "README.md", "tasks.py", "Makefile", "babel.cfg",
-                 "autograder", "sim", "locales"):
+                 "autograder", "content", "sim", "locales"):
         source = REPO / name
         if source.is_dir():
             shutil.copytree(source, folder / name,

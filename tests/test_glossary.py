@@ -10,10 +10,10 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
+from autograder.cli.i18n import i18n_cli
+from autograder.cli.quiz import quiz_cli
 from autograder.i18n import translations
-from autograder.i18n.cli import i18n_cli
 from autograder.i18n.glossary import Glossary, check_language, housekeeping, load_glossary
-from autograder.quiz.cli import quiz_cli
 
 REPO = Path(__file__).resolve().parent.parent
 REAL = REPO / "locales" / "ur" / "glossary.yaml"

@@ -71,7 +71,7 @@ def test_events_executor_ends_with_a_score_and_a_reason(graded):
     """It spins a core without running a callback and ignores SIGINT: stopped, scored,
     explained (the world slows to its CPU budget per tick, so its waits end on the wall)."""
     result = graded["events_executor"]
-    assert result.grader_error is None and not result.data["timed_out"]
+    assert result.grader_error is None and not result.timed_out
     assert result.score == 0
     assert all(t.status in ("failed", "skipped") and t.message for t in result.tests)
     assert result.execution_time < find_exercise("callback_groups").time_limit / 2
@@ -87,7 +87,7 @@ def test_old_scan_is_told_why(graded):
 def test_report_plots_the_scan_rate_reports(graded):
     """The rate tests attach the intervals of scans_per_second they read (about 1 s)."""
     result = graded["reference#0"]
-    charts = {t.name: t.data["charts"] for t in result.tests}
+    charts = {t.name: t.charts for t in result.tests}
     for name in ("test_scan_rate", "test_concurrent_requests", "test_never_deadlocks"):
         (chart,) = charts[name]
         assert chart["title"] == "scans_per_second" and chart["points"], name

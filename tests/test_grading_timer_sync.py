@@ -82,7 +82,7 @@ def test_report_plots_the_intervals_each_rate_test_measured(graded):
     """The report shows the message-interval plots README promises for rate tests, and
     the robot's runs in the long hall as one replayable picture."""
     result = graded["reference#0"]
-    charts = {t.name: t.data["charts"] for t in result.tests}
+    charts = {t.name: t.charts for t in result.tests}
     (control,) = charts["test_control_rate"]
     assert control["title"] == "cmd_vel"
     assert control["limit"] == pytest.approx(0.15)  # the largest gap allowed

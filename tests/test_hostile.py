@@ -21,7 +21,7 @@ from pathlib import Path
 import pytest
 from markupsafe import escape
 
-from autograder.cli import write_outputs
+from autograder.commands.grade import write_outputs
 from autograder.core.exercise import find_exercise
 from autograder.core.results import RunResult
 from autograder.grading.run import grade
@@ -240,8 +240,8 @@ def test_modules_beside_the_node_run_only_as_the_student(graded):
     assert "ROOT CODE RAN" not in result.log
     importers = re.findall(r"^SHADOW (\w+) IMPORTED AS UID (\d+)$", result.log, re.M)
     assert {name for name, _uid in importers} <= {"json"}  # the node's own imports only
-    if result.data["isolation"]["mode"] == "strict":
-        assert {int(uid) for _name, uid in importers} <= set(result.data["student_uids"])
+    if result.isolation["mode"] == "strict":
+        assert {int(uid) for _name, uid in importers} <= set(result.student_uids or ())
 
 
 @strict_only
@@ -298,12 +298,12 @@ def test_without_cgroups_a_daemon_still_ends_with_the_program(course, monkeypatc
     monkeypatch.setenv("AUTOGRADER_CGROUP_ROOT", "/nonexistent")
     result = grade(course, CORPUS / "detached_daemon")
     assert result.grader_error is None
-    assert result.data["isolation"]["bounds"]["cgroup"] is None  # it really had none
+    assert result.isolation["bounds"]["cgroup"] is None  # it really had none
     assert re.search(r"^STUDENT UID \d+$", result.log, re.M), "the daemon started"
     assert leftovers(result) == []
     from autograder.sandbox.sweep import user_processes
 
-    for uid in result.data["student_uids"]:
+    for uid in result.student_uids or ():
         assert user_processes(uid) == []
 
 
@@ -312,16 +312,16 @@ def test_runs_as_its_own_user_where_strict(graded):
     the run's own user in strict isolation, never the grader's; the grader's user in basic
     isolation, and the results say why."""
     result = graded["detached_daemon"][0]
-    isolation = result.data["isolation"]
+    isolation = result.isolation
     assert isolation["mode"] == detect().mode
     seen = {int(uid) for uid in re.findall(r"^STUDENT UID (\d+)$", result.log, re.M)}
     if isolation["mode"] == "strict":
-        assert result.data["student_uid"] is not None
+        assert result.student_uid is not None
         # Test modules run in children of their own, each with its domain's user.
-        assert seen and seen <= set(result.data["student_uids"])
+        assert seen and seen <= set(result.student_uids or ())
         assert os.getuid() not in seen
     else:
-        assert result.data["student_uid"] is None
+        assert result.student_uid is None
         assert seen == {os.getuid()}
         assert isolation["reason"]  # the results say why
 

@@ -10,8 +10,8 @@ import pytest
 from babel.messages.pofile import read_po
 from click.testing import CliRunner
 
+from autograder.cli.i18n import i18n_cli
 from autograder.i18n import translations
-from autograder.i18n.cli import i18n_cli
 from autograder.quiz.extract import extract_exercise, extract_quiz
 
 REPO = Path(__file__).resolve().parent.parent
@@ -189,3 +189,15 @@ def test_extracting_after_a_content_change_touches_only_what_changed(course: Pat
     assert not [line for line in added if line.startswith("#: quizzes/part2")]
     assert [line for line in removed if not line.startswith('"POT-Creation-Date')] == []
 
+
+
+def test_no_entry_reads_as_a_percent_format() -> None:
+    """Our strings use named ``{placeholders}`` only. Babel flags any "% x" as a %-directive
+    ("15% of" is the directive "% o"), and GNU msgfmt --check then refuses a translation
+    that moves the "%" ("15% beams": "% b"), so the catalogs would not compile with gettext's
+    own tools: write "percent" instead."""
+    root = Path(__file__).resolve().parent.parent / "locales"
+    for template in sorted(root.glob("*.pot")):
+        with template.open("rb") as fh:
+            flagged = [m.id for m in read_po(fh) if m.id and "python-format" in m.flags]
+        assert flagged == [], f"{template}: {flagged}"

@@ -148,7 +148,7 @@ def test_a_reliable_stop_is_acknowledged_within_the_wait(tmp_path):
 def test_user_tasks_counts_threads_as_rlimit_nproc_does(tmp_path):
     """Without a uid of its own, a student's RLIMIT_NPROC is what its user already runs plus
     its own allowance, so the count is of threads (as RLIMIT_NPROC counts), by real uid."""
-    from autograder.sandbox.launcher import user_tasks
+    from autograder.sandbox.contained.launcher import user_tasks
 
     def process(pid: str, uids: str, threads: int | None) -> None:
         (tmp_path / pid).mkdir()

@@ -17,7 +17,7 @@ CLEAR = "\r\x1b[2K"
 
 def passed(name: str, label: str) -> TestResult:
     return TestResult(name, label, Fraction(1), Fraction(1), "passed",
-                      data={"nodeid": f"t.py::{name}"})
+                      nodeid=f"t.py::{name}")
 
 
 class Clock:
@@ -105,7 +105,7 @@ def test_modules_at_once_are_all_on_the_line_so_the_one_that_ends_was_named():
     live.running_now([("a.py::test_a", "The node starts"), ("b.py::test_b", "It turns")])
     assert out[-1] == CLEAR + " …   2 s  The node starts  ·    0 s  It turns"
     live.done(TestResult("test_b", "It turns", Fraction(1), Fraction(1), "passed",
-                         data={"nodeid": "b.py::test_b"}))
+                         nodeid="b.py::test_b"))
     clock.now += 1.0
     live.running_now([("a.py::test_a", "The node starts")])  # its time kept, not restarted
     assert out[-2:] == [" ✔   1/1  It turns\n", CLEAR + " …   3 s  The node starts"]

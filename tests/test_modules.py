@@ -1,5 +1,5 @@
 """Test modules shared out among child pytests and their reports merged
-(autograder.grading.modules), and one grading run that way end to end."""
+(autograder.grading.module_groups), and one grading run that way end to end."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ from autograder.core.exercise import load_exercise
 from autograder.core.report import RawReport, RawTest
 from autograder.core.results import RunResult
 from autograder.grading.children import Child, Ended
-from autograder.grading.modules import children_for, find_modules, merge, share_out
+from autograder.grading.module_groups import children_for, find_modules, merge, share_out
 from autograder.grading.run import GRADER_FAULT, _result
 
 PUBLIC, HIDDEN_A, HIDDEN_B = "tests/public/test_p.py", "tests/hidden/test_a.py", \
@@ -147,17 +147,17 @@ def test_a_grading_runs_its_modules_in_two_children_on_two_domains(
     result = grade(exercise, None, module_jobs=2)
     assert result.grader_error is None, result.grader_details
     assert result.score == result.max_score == exercise.points
-    assert [t.data["nodeid"] for t in result.tests] == _collected(exercise.folder)
-    domains = result.data["domains"]
+    assert [t.nodeid for t in result.tests] == _collected(exercise.folder)
+    domains = result.domains
     assert len(domains) == 2 and len(set(domains)) == 2
-    assert result.data["timing"]["children"] == 2
-    modules = {t.data["nodeid"].split("::")[0] for t in result.tests}
-    assert set(result.data["timing"]["modules"]) == modules
-    assert set(result.data["pacing"]) == {m.rpartition("/")[2] for m in modules}
-    assert set(result.data["recordings"]) == set(result.data["pacing"])
+    assert result.timing["children"] == 2
+    modules = {t.nodeid.split("::")[0] for t in result.tests}
+    assert set(result.timing["modules"]) == modules
+    assert set(result.pacing) == {m.rpartition("/")[2] for m in modules}
+    assert set(result.recordings) == set(result.pacing)
     # The tree's PSS: this process, two children and a student each at a time, each
     # counting at most its resident size (PSS divides the pages it shares).
-    memory = result.data["memory"]
+    memory = result.memory
     own_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     assert 0 < memory["footprint_mb"] < memory["total_mb"] + own_mb
     # The children kept their bytecode (hidden tests' included) in the user's cache, and
@@ -201,7 +201,7 @@ def test_a_child_stopped_at_the_time_limit_says_so_for_its_own_tests_only() -> N
     assert [(t.name, t.status) for t in result.tests] == [
         ("p", "passed"), ("a", "failed"), ("b", "passed")]
     assert "time limit" in result.tests[1].message
-    assert result.grader_error is None and result.data["timed_out"] is True
+    assert result.grader_error is None and result.timed_out is True
     assert result.score == 2
 
 
@@ -229,7 +229,7 @@ def test_grade_batch_runs_modules_at_once_only_when_it_grades_one_at_a_time(
     monkeypatch.setenv("AUTOGRADER_COURSE", str(SHOUT.parent.parent))
     asked: list[int | str] = []
 
-    def fake_grade(exercise, path, *, module_jobs="auto", **_kw):  # noqa: ANN001, ANN202
+    def fake_grade(exercise, path, *, module_jobs="auto", **_kw):
         asked.append(module_jobs)
         return RunResult(kind="exercise", id="shout", title="Shout", tests=())
 

@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from autograder.cli import _batch_item, write_outputs
-from autograder.core.output import (
+from autograder.commands.grade import batch_item, write_outputs
+from autograder.core.output_budget import (
     CUT,
     LINE_CHARS,
     TAIL_BYTES,
@@ -211,7 +211,7 @@ def test_without_the_whole_log_the_html_shows_the_tail():
 def test_a_batch_writes_each_students_log(tmp_path, monkeypatch):
     monkeypatch.setenv("AUTOGRADER_COURSE", str(Path(__file__).parent / "fixtures" /
                                                  "mini_course"))
-    _grade, _suffix, extra = _batch_item("shout")
+    _grade, _suffix, extra = batch_item("shout")
     extra(run_result("the student's output\n"), tmp_path)
     assert (tmp_path / "output.log").read_text() == "the student's output\n"
     assert "the student&#39;s output" in (tmp_path / "report.html").read_text()

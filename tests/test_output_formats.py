@@ -8,7 +8,8 @@ from pathlib import Path
 
 from click.testing import CliRunner
 
-from autograder.cli import main, write_outputs
+from autograder.cli import main
+from autograder.commands.grade import write_outputs
 from autograder.core.results import RunResult, TestResult
 from autograder.render import OutputFormat, formats
 

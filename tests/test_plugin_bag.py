@@ -70,7 +70,7 @@ def graph(ros_domain: int) -> Iterator[tuple[Probe, Node, list[tuple[str, str, A
         rclpy.try_shutdown(context=context)
 
 
-def test_the_probe_hands_over_each_message_once(graph) -> None:  # noqa: ANN001
+def test_the_probe_hands_over_each_message_once(graph) -> None:
     probe, student, tapped = graph
     status = probe.subscribe(String, "/status")
     odom = probe.subscribe(Odometry, "/odom")
@@ -102,7 +102,7 @@ class FakeBridge:
         self.taps.append(tap)
 
 
-def _request(tmp_path: Path, record: Path, module: str = "tests/public/test_drive.py"):  # noqa: ANN202
+def _request(tmp_path: Path, record: Path, module: str = "tests/public/test_drive.py"):
     config = SimpleNamespace(stash=pytest.Stash())
     config.stash[settings_key] = RunSettings(exercise="/course/assignments/drive",
                                             record=str(record))
@@ -154,7 +154,7 @@ def test_the_grader_warns_when_the_folder_cannot_be_made(tmp_path: Path) -> None
 
 def test_results_list_the_bags_and_warnings() -> None:
     result = RunResult(kind="exercise", id="x", title="X", tests=(),
-                       data={"bags": {"test_a": "/r/test_a"}, "warnings": ["disk full"]})
+                       bags={"test_a": "/r/test_a"}, warnings=("disk full",))
     shown = result.to_dict()
     assert shown["bags"] == {"test_a": "/r/test_a"} and shown["warnings"] == ["disk full"]
     assert "bags" not in RunResult(kind="exercise", id="x", title="X", tests=()).to_dict()
@@ -162,7 +162,7 @@ def test_results_list_the_bags_and_warnings() -> None:
 
 def test_grade_batch_records_each_student_in_a_folder_of_their_own(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    from autograder import cli
+    from autograder.commands import grade
     from autograder.grading import run
 
     monkeypatch.setenv("AUTOGRADER_COURSE", str(COURSE))
@@ -170,7 +170,7 @@ def test_grade_batch_records_each_student_in_a_folder_of_their_own(
     monkeypatch.setattr(run, "grade", lambda exercise, path, record=None, **_kw:
                         asked.append(record))
     (tmp_path / "bob").mkdir()
-    grade_one, _, _ = cli._batch_item("shout", tmp_path / "bags")
+    grade_one, _, _ = grade.batch_item("shout", tmp_path / "bags")
     grade_one(tmp_path / "alice.py")
     grade_one(tmp_path / "bob")
     assert asked == [tmp_path / "bags" / "alice", tmp_path / "bags" / "bob"]

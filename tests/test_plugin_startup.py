@@ -131,7 +131,7 @@ class Clock:
 def test_time_spent_waiting_for_a_cpu_does_not_count_toward_the_start_up(monkeypatch):
     """A busy machine keeps the program waiting for a CPU 0.9 s of every second: its node
     shows after 30 s of wall time, 3 s of its own, within a 10 s start-up."""
-    from autograder.sandbox import graph as graph_module
+    from autograder.plugin import graph as graph_module
 
     graph = Graph([], [Info(NAME, b"new")], delay=30)
     monkeypatch.setattr(graph_module.time, "monotonic", Clock(graph))
@@ -147,7 +147,7 @@ def test_time_spent_waiting_for_a_cpu_does_not_count_toward_the_start_up(monkeyp
 
 def test_a_start_up_starved_past_its_cap_is_the_graders_failure(monkeypatch):
     from autograder.core.errors import GraderError
-    from autograder.sandbox import graph as graph_module
+    from autograder.plugin import graph as graph_module
 
     graph = Graph([], [Info(NAME, b"new")], delay=500)
     monkeypatch.setattr(graph_module.time, "monotonic", Clock(graph))

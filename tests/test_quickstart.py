@@ -2,10 +2,11 @@
 clone of the course, in a terminal of its own, as an ordinary user where the machine lets
 the test make one. The README's quickstart is the same commands as the docs page's.
 
-What is not run: `python3 tasks.py demo`, the set-up, which would reinstall the venv these
-tests run in; CI runs it from fresh clones, as root and as ordinary users
-(`.ci/deployments`). The clone's `.venv` is a link to that venv, so `. .venv/bin/activate`
-runs as pasted."""
+The set-up block (`python3 tasks.py demo`, then the activation) would reinstall the venv
+these tests run in, so here the clone's `.venv` is a link to that venv and only the
+activation runs; CI's `.ci/deployments` runs the set-up block as this page prints it, from
+fresh clones, as root and as two ordinary users (`test_ci_runs_the_setup_block_as_pasted`
+holds it to that)."""
 
 from __future__ import annotations
 
@@ -42,6 +43,35 @@ def test_the_quickstart_shows_what_the_issue_asks() -> None:
                    "autograder sim drive", "--record", "autograder quiz take",
                    "autograder quiz score"):
         assert needed in text, needed
+
+
+# Words a newcomer reads before the command that grades the starter: 5 minutes at 200
+# words a minute, a slow pace for technical text (code blocks count as words too).
+READING_BUDGET_WORDS = 5 * 200
+
+
+def _words_before_grading(text: str) -> int:
+    before = text.split("autograder grade parameter_validation mywork", 1)
+    assert len(before) == 2, "the page never shows the command that grades the starter"
+    return len(before[0].split())
+
+
+@pytest.mark.parametrize("page", ["README.md", "docs/ur/students/quickstart.md"])
+def test_a_newcomer_reaches_a_graded_starter_in_five_minutes_of_reading(page: str) -> None:
+    """Issue 35: from the top of the README (or the Urdu quickstart, where the README's
+    first link sends Urdu readers), the words before `autograder grade ... mywork`."""
+    words = _words_before_grading((ROOT / page).read_text(encoding="utf-8"))
+    assert words <= READING_BUDGET_WORDS, f"{page}: {words} words before the grading command"
+
+
+def test_ci_runs_the_setup_block_as_pasted() -> None:
+    """The set-up block is not run here (see the module's docstring): `.ci/deployments`
+    takes it from this page, not from a copy of its own, and runs it whole in each clone."""
+    script = (ROOT / ".ci" / "deployments").read_text(encoding="utf-8")
+    assert "docs/students/quickstart.md" in script
+    runs = [line for line in script.splitlines()
+            if "tasks.py demo" in line and not line.lstrip().startswith("#")]
+    assert runs == [], f".ci/deployments runs its own copy of the set-up: {runs}"
 
 
 def _clone(folder: Path) -> None:

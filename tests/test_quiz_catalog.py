@@ -15,12 +15,12 @@ import yaml
 from click.testing import CliRunner
 
 from autograder.cli import main
+from autograder.cli.quiz import quiz_cli
 from autograder.quiz.catalog import find_quiz, load_each
-from autograder.quiz.cli import quiz_cli
 from autograder.quiz.model import load_quiz
 from autograder.quiz.scoring import score
 from autograder.quiz.server import QuizServer
-from sim.content import ContentError
+from content import ContentError
 
 GOOD = """\
 id: good

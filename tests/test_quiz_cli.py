@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
-from autograder.quiz.cli import quiz_cli
+from autograder.cli.quiz import quiz_cli
 from autograder.quiz.model import load_quiz
 from autograder.quiz.render import question_views
 

@@ -24,13 +24,14 @@ from typing import Any
 import pytest
 from click.testing import CliRunner
 
+from autograder.cli.quiz import quiz_cli
 from autograder.core.errors import ContentError
 from autograder.i18n import _
+from autograder.i18n.text import CODE_SPAN, LRI, PDI, Text, using_language
 from autograder.quiz.catalog import load_all
-from autograder.quiz.cli import quiz_cli
 from autograder.quiz.export import export_moodle_xml, export_qti
 from autograder.quiz.export.xml import CData, el, to_xml
-from autograder.quiz.localize import CODE_SPAN, LRI, PDI, Localizer, Text, using_language
+from autograder.quiz.localize import Localizer
 from autograder.quiz.model import Question, Quiz, QuizFile, load_quiz
 from autograder.quiz.scoring import key_answers, pass_summary
 from autograder.quiz.types import question_type, registry

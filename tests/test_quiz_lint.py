@@ -9,8 +9,8 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
+from autograder.cli.quiz import quiz_cli
 from autograder.i18n import translations
-from autograder.quiz.cli import quiz_cli
 
 REPO = Path(__file__).resolve().parent.parent
 # The quizzes these tests read: a frozen copy, so that editing quizzes/ never breaks a

@@ -8,10 +8,10 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
+from autograder.cli.quiz import quiz_cli
 from autograder.core.errors import ContentError
 from autograder.i18n import translations
 from autograder.quiz.catalog import list_quizzes, load_all
-from autograder.quiz.cli import quiz_cli
 from autograder.quiz.model import load_quiz
 
 REPO = Path(__file__).resolve().parent.parent

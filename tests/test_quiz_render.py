@@ -9,8 +9,8 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
+from autograder.cli.quiz import quiz_cli
 from autograder.i18n import translations
-from autograder.quiz.cli import quiz_cli
 from autograder.quiz.model import load_quiz
 from autograder.quiz.render import render_markdown, render_page
 from autograder.quiz.scoring import score

@@ -10,9 +10,9 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
+from autograder.cli.quiz import quiz_cli
 from autograder.core.errors import ContentError
 from autograder.quiz.catalog import load_all
-from autograder.quiz.cli import quiz_cli
 from autograder.quiz.model import load_quiz
 from autograder.quiz.scoring import key_answers, pass_summary, read_answers, score
 

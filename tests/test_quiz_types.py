@@ -12,10 +12,10 @@ from typing import Any
 import pytest
 from click.testing import CliRunner
 
+from autograder.cli.quiz import quiz_cli
 from autograder.core.errors import ContentError
+from autograder.i18n.text import markdown_inline
 from autograder.quiz.catalog import load_all
-from autograder.quiz.cli import quiz_cli
-from autograder.quiz.localize import markdown_inline
 from autograder.quiz.model import Question, load_quiz
 from autograder.quiz.render import render_markdown, render_page
 from autograder.quiz.scoring import check_answers, key_answers, score
@@ -32,7 +32,7 @@ from autograder.quiz.types.base import (
     one_picked_id,
 )
 from autograder.quiz.views import QuestionView, question_views
-from sim.content import Document
+from content import Document
 
 REPO = Path(__file__).resolve().parent.parent
 SHIPPED = {"single", "multiple", "true_false", "numeric", "ordering"}

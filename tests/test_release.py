@@ -52,7 +52,7 @@ def test_release_has_what_students_need(release):
         assert (folder / "starter" / exercise.file).exists()
         assert (folder / "README.md").exists() and (folder / "README.ur.md").exists()
         assert any((folder / "tests" / "public").glob("test_*.py"))
-    assert (release / "autograder" / "cli.py").exists()
+    assert (release / "autograder" / "cli" / "__init__.py").exists()
     assert (release / "pyproject.toml").exists()
     assert (release / "quizzes-rendered" / "rclpy-part2.ur.html").exists()
 

@@ -37,7 +37,7 @@ def recorded(world: str, seconds: float, linear: float = 0.4, turn: float = 0.8,
 
 def a_test(module: str, name: str, label: str) -> TestResult:
     return TestResult(name, label, Fraction(1), Fraction(1), "passed",
-                      data={"charts": [], "module": module})
+                      nodeid=f"tests/public/{module}::{name}")
 
 
 @pytest.fixture(scope="module")
@@ -53,7 +53,7 @@ def result() -> RunResult:
                   "test_startup.py": recorded("empty_room", 3, linear=0.0, turn=0.0),
                   "test_faulty.py": recorded("obstacles", 10)}
     return RunResult("exercise", "parameter_validation", "A velocity governor", tests,
-                     data={"recordings": recordings})
+                     recordings=recordings)
 
 
 @pytest.fixture(autouse=True)
@@ -148,7 +148,7 @@ def test_an_old_results_file_gives_the_static_picture() -> None:
         del old[key]
     result = RunResult("exercise", "parameter_validation", "A velocity governor",
                        (a_test("test_governor.py", "test_clamps", "Clamped"),),
-                       data={"recordings": {"test_governor.py": old}})
+                       recordings={"test_governor.py": old})
     page = to_html(result)
     (figure,) = _figures(page)
     assert 'class="path"' in figure and "test_governor.py" in figure
@@ -158,6 +158,6 @@ def test_an_old_results_file_gives_the_static_picture() -> None:
 
 def test_urdu_page_keeps_the_picture_and_controls_left_to_right(result: RunResult) -> None:
     page = to_html(RunResult(result.kind, result.id, result.title, result.tests, lang="ur",
-                             data=result.data))
+                             recordings=result.recordings))
     assert '<html lang="ur" dir="rtl">' in page
     assert page.count('<div class="scene" dir="ltr">') == 2

@@ -30,13 +30,13 @@ def urdu_result() -> RunResult:
                    "failed", message="`cmd_vel` simulation time میں 3.1 Hz پر آیا؛ planner "
                    "کے چلتے ہوئے بھی control loop کو 10 Hz رکھنا ہے۔",
                    hint="کیا planner اپنے callback group میں ہے؟",
-                   data={"charts": [{"kind": "intervals", "title": "cmd_vel",
-                                     "points": [[0.1 * i, 0.1] for i in range(1, 30)]
-                                     + [[3.5, 0.6]], "limit": 0.15}]}),
+                   charts=({"kind": "intervals", "title": "cmd_vel",
+                            "points": [[0.1 * i, 0.1] for i in range(1, 30)]
+                            + [[3.5, 0.6]], "limit": 0.15},)),
     )
     return RunResult("exercise", "timer_sync", "Timer synchronization: ایک multi-rate controller",
                      tests, lang="ur", log_tail="[INFO] [multi_rate_controller]: started",
-                     data={"recordings": {"test_world.py": recording.to_dict()}})
+                     recordings={"test_world.py": recording.to_dict()})
 
 
 _LAYOUT_JS = """
@@ -105,8 +105,8 @@ def test_urdu_report_captions_read_right_to_left(tmp_path: Path) -> None:
     (tmp_path / "practice_yard.yaml").write_text(
         "title: Practice yard, 6 x 6 m\nsize: [6.0, 6.0]\n", encoding="utf-8")
     result = urdu_result()
-    recorded = {**result.data["recordings"]["test_world.py"], "world": "practice_yard"}
-    result = dataclasses.replace(result, data={"recordings": {"test_world.py": recorded}})
+    recorded = {**result.recordings["test_world.py"], "world": "practice_yard"}
+    result = dataclasses.replace(result, recordings={"test_world.py": recorded})
     page_file = tmp_path / "report.ur.html"
     page_file.write_text(to_html(result, tmp_path), encoding="utf-8")
     with chromium_page() as page:
@@ -153,12 +153,12 @@ def replay_result(lang: str = "en") -> RunResult:
              a_test("test_faulty_world.py", "test_no_collision", "No collision"),
              a_test("test_shutdown.py", "test_stops", "Stops on SIGINT"))
     return RunResult("exercise", "error_handling", "A robust obstacle avoider", tests,
-                     lang=lang, data={"recordings": {
+                     lang=lang, recordings={
                          "test_avoider.py": recorded("wall_ahead", 12, linear=0.1, turn=0.0),
                          "test_faulty_world.py": recorded(
                              "wall_ahead", 8, turn=-0.6,
                              faults=(Fault(kind="dropout", start=4.0),)),
-                         "test_shutdown.py": recorded("obstacles", 12, turn=1.0)}})
+                         "test_shutdown.py": recorded("obstacles", 12, turn=1.0)})
 
 
 def test_replay_slider_moves_the_robot_its_scan_and_command(tmp_path: Path) -> None:

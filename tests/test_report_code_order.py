@@ -17,7 +17,7 @@ from pathlib import Path
 import pytest
 from browser import chromium_page
 
-from autograder.quiz.localize import CODE_SPAN, ltr_runs
+from autograder.i18n.text import CODE_SPAN, ltr_runs
 
 REPO = Path(__file__).resolve().parent.parent
 EXERCISES = sorted(p.parent.name for p in (REPO / "assignments").glob("*/exercise.yaml"))

@@ -15,7 +15,7 @@ from typing import Any
 
 import pytest
 
-from autograder.core.output import CUT, MESSAGE_BYTES
+from autograder.core.output_budget import CUT, MESSAGE_BYTES
 from autograder.core.settings import RunSettings
 from autograder.core.signing import Forged, verify
 

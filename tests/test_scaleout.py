@@ -75,7 +75,7 @@ def platform(root_dir: Path) -> Path:
     ignore = shutil.ignore_patterns("__pycache__", "*.pyc")
     for name in ("pyproject.toml", "README.md"):
         shutil.copy(ROOT / name, copy / name)
-    for name in ("autograder", "sim"):
+    for name in ("autograder", "content", "sim"):
         shutil.copytree(ROOT / name, copy / name, ignore=ignore)
     return copy
 

@@ -108,7 +108,7 @@ def test_faults_from_the_world_file(tmp_path) -> None:
 def test_a_new_kind_is_one_table_entry(tmp_path, monkeypatch: pytest.MonkeyPatch) -> None:
     """Adding a kind to sim.faultkinds.KINDS is enough for world files and the injector."""
 
-    def zero(scan: ScanDraft, fault: Fault, pick) -> None:  # noqa: ANN001
+    def zero(scan: ScanDraft, fault: Fault, pick) -> None:
         scan.ranges[pick(fault.fraction)] = 0.0
 
     monkeypatch.setitem(KINDS, "zero", FaultKind("a share of beams reads 0",

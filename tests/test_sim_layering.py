@@ -11,16 +11,16 @@ from pathlib import Path
 
 import pytest
 
-import sim.i18n
+import content.i18n
 from autograder.i18n import set_language
-from sim.content import ContentError
+from content import ContentError
 from sim.worldfile import load_world
 
 REPO = Path(__file__).resolve().parent.parent
 
 
 def test_sim_imports_nothing_of_autograder() -> None:
-    code = ("import sys, sim.bridge, sim.cli, sim.worldfile, sim.content, sim.faults, "
+    code = ("import sys, sim.bridge, sim.cli, sim.worldfile, content, sim.faults, "
             "sim.engine, sim.svg, sim.recorder, sim.pacing, sim.procstate, sim.bag\n"
             "leaked = sorted(m for m in sys.modules if m.split('.')[0] == 'autograder')\n"
             "assert not leaked, leaked\n")
@@ -41,7 +41,7 @@ def urdu() -> Iterator[None]:
 
 
 def test_sim_messages_follow_the_autograder_language(urdu: None, tmp_path: Path) -> None:
-    assert sim.i18n.get_language() == "ur"
+    assert content.i18n.get_language() == "ur"
     empty = tmp_path / "empty.yaml"
     empty.write_text("")
     with pytest.raises(ContentError, match="فائل خالی ہے"):  # "the file is empty"
@@ -69,10 +69,10 @@ def test_sim_alone_honours_autograder_locales(tmp_path: Path,
         'msgid ""\nmsgstr "Content-Type: text/plain; charset=UTF-8\\n"\n\n'
         'msgid "the file is empty"\nmsgstr "خالی"\n', encoding="utf-8")
     monkeypatch.setenv("AUTOGRADER_LOCALES", str(tmp_path))
-    before = sim.i18n.get_language()
-    sim.i18n.set_language("ur")
+    before = content.i18n.get_language()
+    content.i18n.set_language("ur")
     try:
-        assert sim.i18n._("the file is empty") == "خالی"
-        assert sim.i18n._("the goal is outside the arena") == "the goal is outside the arena"
+        assert content.i18n._("the file is empty") == "خالی"
+        assert content.i18n._("the goal is outside the arena") == "the goal is outside the arena"
     finally:
-        sim.i18n.set_language(before)
+        content.i18n.set_language(before)

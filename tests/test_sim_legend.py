@@ -106,10 +106,10 @@ def test_the_legend_grows_with_a_wider_world_so_its_text_keeps_its_size() -> Non
 def _report(lang: str, collisions: int) -> str:
     test = TestResult(name="test_drives", label="Drives", score=Fraction(1),
                       max_score=Fraction(1), status="passed",
-                      data={"module": "test_a.py"})
+                      nodeid="test_a.py::test_drives")
     return to_html(RunResult("exercise", "error_handling", "Avoider", (test,), lang=lang,
-                             data={"recordings": {
-                                 "test_a.py": _recording(collisions).to_dict()}}))
+                             recordings={
+                                 "test_a.py": _recording(collisions).to_dict()}))
 
 
 def _caption(page: str) -> str:

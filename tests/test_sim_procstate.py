@@ -31,7 +31,7 @@ def _spinning() -> subprocess.Popen[str]:
     return proc
 
 
-def _poll(condition, timeout: float = WALL) -> bool:  # noqa: ANN001
+def _poll(condition, timeout: float = WALL) -> bool:
     end = time.monotonic() + timeout
     while time.monotonic() < end:
         if condition():
@@ -132,7 +132,7 @@ def _name_thread(tid: int, name: str) -> None:
         fh.write(name)
 
 
-def test_receiving_follows_the_receive_threads_by_name(tmp_path) -> None:  # noqa: ANN001
+def test_receiving_follows_the_receive_threads_by_name(tmp_path) -> None:
     """A thread named as Fast DDS names its receive threads counts while it runs; it and
     a thread of another name do not while they wait."""
     import threading
@@ -175,7 +175,7 @@ def test_receiving_follows_the_receive_threads_by_name(tmp_path) -> None:  # noq
     assert not receiving()  # closed: nothing to wait for
 
 
-def test_receiving_counts_packets_the_kernel_still_holds(tmp_path) -> None:  # noqa: ANN001
+def test_receiving_counts_packets_the_kernel_still_holds(tmp_path) -> None:
     """softnet_stat's backlog column (Linux 5.10+), summed over CPUs; older kernels'
     shorter rows say nothing, so they count as none."""
     stat = tmp_path / "softnet_stat"

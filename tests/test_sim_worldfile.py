@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from sim.content import ContentError
+from content import ContentError
 from sim.faultkinds import KINDS
 from sim.worldfile import ROBOT_RADIUS, LidarSpec, WorldSpec, load_world, world_names
 

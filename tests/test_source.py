@@ -207,7 +207,7 @@ def test_grading_a_syntax_error_scores_zero_with_one_message_and_no_world(
     assert (result.score, result.max_score) == (0, exercise.points)
     assert len(result.tests) == 1
     assert "    def on_cmd(self, msg)\n" in result.tests[0].message
-    assert "domain" not in result.data and "processes" not in result.data
+    assert result.domain is None and result.processes == ()
 
 
 def test_grade_batch_gives_a_refused_file_a_zero_with_its_message(tmp_path: Path) -> None:

@@ -125,7 +125,7 @@ def test_a_student_who_joins_another_grading_fails_its_own(shout):
             result = grade(shout, CORPUS / "joins_other_domain")
         finally:
             _stop(victim)
-    assert result.data["isolation"]["mode"] == "user"
+    assert result.isolation["mode"] == "user"
     assert f"JOINED DOMAIN {other.domain}" in result.log
     assert result.grader_error is None, result.grader_details
     assert result.score < result.max_score
@@ -248,7 +248,7 @@ def test_a_program_that_hoards_every_domain_blocks_no_classmate(shout):
     assert sum(int(locks) for locks, _ports, _uid in held) > 0, hoarder.log[-2000:]
     assert classmate.grader_error is None, classmate.grader_details
     assert classmate.score == classmate.max_score
-    for strangers in classmate.data.get("disturbed", []):
+    for strangers in classmate.disturbed:
         assert set(strangers) <= {int(uid) for _locks, _ports, uid in held}
     assert hoarder.grader_error is None and hoarder.score < hoarder.max_score
     assert "which is not its own" in "\n".join(t.message for t in hoarder.tests)
@@ -285,6 +285,6 @@ def test_a_disturbed_grading_is_graded_again_once_the_stranger_is_gone(shout):
         if not sitter.stdin.closed:
             sitter.stdin.close()
         sitter.wait(timeout=30)
-    assert result.data.get("disturbed") == [[stranger]]
+    assert result.disturbed == ((stranger,),)
     assert result.grader_error is None, result.grader_details
     assert result.score == result.max_score

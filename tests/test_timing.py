@@ -87,7 +87,7 @@ def test_a_grading_says_where_its_seconds_and_memory_went() -> None:
     assert result.grader_error is None, result.grader_details
     data = result.to_dict()
     timing, memory = data["timing"], data["memory"]
-    modules = {t.data["nodeid"].split("::")[0] for t in result.tests}
+    modules = {t.nodeid.split("::")[0] for t in result.tests}
     assert set(timing["modules"]) == modules
     for row in timing["modules"].values():
         assert all(row[key] >= 0 for key in (*PHASES, "checks", "total"))

@@ -15,7 +15,7 @@ from types import SimpleNamespace
 import click
 import pytest
 
-from autograder.core.output import TAIL_BYTES
+from autograder.core.output_budget import TAIL_BYTES
 from autograder.core.results import RunResult, TestResult
 from autograder.core.untrusted import visible
 from autograder.i18n import set_language

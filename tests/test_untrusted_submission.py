@@ -55,7 +55,7 @@ def _shadowed(folder: Path) -> Path:
 
 
 def test_the_privileged_command_is_isolated_and_names_no_student_folder():
-    command = module_command("autograder.sandbox.launcher", ["SPEC"])
+    command = module_command("autograder.sandbox.contained.launcher", ["SPEC"])
     assert command[1] == "-I"  # no working directory, no PYTHON* variables, no user site
     assert SAFE_CWD == "/"
 

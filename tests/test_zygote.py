@@ -3,7 +3,7 @@
 Each case runs the same program both ways (``AUTOGRADER_ZYGOTE=0`` execs it through the
 launcher) and compares what a grader sees: exit status, output, and the program's view
 of itself (argv, working folder, environment, module path, ``__name__``, the thread
-switch interval of :mod:`autograder.sandbox.runner`).
+switch interval of :mod:`autograder.sandbox.contained.runner`).
 """
 
 from __future__ import annotations
@@ -18,8 +18,8 @@ import pytest
 
 from autograder.core.exercise import Limits
 from autograder.sandbox import process as process_module
+from autograder.sandbox.contained.zygote import ForkedProcess
 from autograder.sandbox.process import LaunchFailed, StudentProcess, student_process
-from autograder.sandbox.zygote import ForkedProcess
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -20,9 +20,9 @@ from pathlib import Path
 import yaml
 from babel.messages.pofile import normalize
 
-from autograder.core.course import course_root
 from autograder.core.errors import ContentError
 from autograder.i18n import _
+from content.course import course_root
 
 EXERCISE_ID = re.compile(r"^[a-z][a-z0-9_]*$")
 QUIZ_ID = re.compile(r"^[a-z][a-z0-9-]*$")

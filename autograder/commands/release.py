@@ -16,14 +16,14 @@ import stat
 import zipfile
 from pathlib import Path
 
-from autograder.core.course import course_root
 from autograder.core.errors import ContentError
 from autograder.core.exercise import Exercise, list_exercises
 from autograder.i18n import _, packaged_locales, translations
+from content.course import course_root
 
 # The platform itself: what `pip install .` needs and what runs the tests.
 PLATFORM = ("pyproject.toml", "README.md", "tasks.py", "Makefile", "babel.cfg", "autograder",
-            "sim", "locales")
+            "content", "sim", "locales")
 _IGNORE = shutil.ignore_patterns("__pycache__", "*.pyc", "*.mo", ".*")
 
 

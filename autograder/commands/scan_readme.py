@@ -43,9 +43,9 @@ def check_scan_readme(exercise: Exercise, path: Path, text: str) -> list[Problem
     line, code = blocks[0]
     try:
         namespace: dict[str, Any] = {}
-        exec(compile(code, str(path), "exec"), namespace)  # noqa: S102 - the course's own
+        exec(compile(code, str(path), "exec"), namespace)  # the course's own
         found = [_nearest(namespace["front_sector"], angle_min) for angle_min in (0.0, -math.pi)]
-    except Exception as exc:  # noqa: BLE001 - any failure of the example is its problem
+    except Exception as exc:  # any failure of the example is its problem
         return [*problems, Problem(path, line, _(
             "the `front_sector` example fails on a real scan: {error}").format(
             error=f"{type(exc).__name__}: {exc}"))]

@@ -16,7 +16,7 @@ from autograder.core.exercise import Exercise, assignments_dir, load_exercise, t
 from autograder.core.results import RunResult, number
 from autograder.i18n import _
 from autograder.i18n.tools import Problem
-from sim.content import load_document
+from content import load_document
 
 
 def _from(exc: ContentError) -> Problem:
@@ -102,11 +102,11 @@ def _gradings(exercise: Exercise, grade: Callable[..., RunResult]) -> list[Probl
 def validate(root: Path | None = None, *, run_gradings: bool = True, jobs: int = 2,
              progress: Callable[[str], None] | None = None) -> list[Problem]:
     """Every problem in the course tree (``root`` defaults to the course in use)."""
-    from autograder.core.course import course_root
     from autograder.grading.run import grade
     from autograder.i18n import locales_dir
-    from autograder.i18n.cli import check_all
+    from autograder.i18n.glossary import check_all
     from autograder.quiz.lint import lint
+    from content.course import course_root
 
     folder = root / "assignments" if root else assignments_dir()
     problems: list[Problem] = []

@@ -1,14 +1,16 @@
-"""The exception families: the student's failure, our own fault, a malformed content file.
+"""The exception families: the student's failure, our own fault, the user's bad input (a
+malformed content file among it).
 
-:class:`ContentError` (``path:line: field: message``) is defined by the content layer in
-``sim.content``, the lowest layer; the autograder imports it from here.
+:class:`ContentError` (``path:line: field: message``) belongs to the content layer
+(:mod:`content`), below the simulator and the autograder; it is listed here with the other
+two families.
 """
 
 from __future__ import annotations
 
-from sim.content import ContentError
+from content import ContentError
 
-__all__ = ["ContentError", "Disturbed", "GraderError", "StudentFailure"]
+__all__ = ["ContentError", "Disturbed", "GraderError", "StudentFailure", "UsageError"]
 
 
 class StudentFailure(AssertionError):
@@ -18,6 +20,11 @@ class StudentFailure(AssertionError):
         super().__init__(message)
         self.message = message
         self.hint = hint
+
+
+class UsageError(Exception):
+    """Bad input from the user (a missing file, an unknown exercise): one line saying what
+    is wrong, the user's to fix. The CLI ends with exit status 2."""
 
 
 class GraderError(Exception):

@@ -8,10 +8,10 @@ from fractions import Fraction
 from pathlib import Path
 from typing import Literal
 
-from autograder.core.course import course_root
 from autograder.core.names import unknown_exercise
 from autograder.i18n import _, content_text
-from sim.content import ContentError, build, load_document
+from content import ContentError, build, load_document
+from content.course import course_root
 from sim.pacing import DEFAULT_CLOCK_HZ, DEFAULT_CPU_BUDGET
 
 

@@ -13,7 +13,7 @@ from collections.abc import Iterable
 from pathlib import Path
 
 from autograder.i18n import _
-from sim.content import ContentError
+from content import ContentError
 
 
 class UnknownName(ContentError):

@@ -15,7 +15,7 @@ import json
 from pathlib import Path
 from typing import Any
 
-from autograder.core.output import digest, log_folder
+from autograder.core.output_budget import digest, log_folder
 from autograder.core.signing import Forged, sign, verify
 from autograder.i18n import _
 

@@ -7,6 +7,7 @@ Renderers are pure functions of a :class:`RunResult`; see ``autograder.render``.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Mapping
 from decimal import Decimal
 from fractions import Fraction
 from typing import Any, Literal
@@ -57,9 +58,14 @@ class TestResult:
     visibility: Visibility = "visible"
     reveal: Reveal = "message"
     details: str = ""
-    data: dict[str, Any] = dataclasses.field(default_factory=dict)
     # A core test (exercise.yaml's ``core``): without it passed, the grading does not pass.
     core: bool = False
+    # pytest's id of the test (``tests/public/test_x.py::test_y``); empty for a question.
+    nodeid: str = ""
+    # The charts the test drew (see ``autograder.plugin.credit``), for the HTML report.
+    charts: tuple[Mapping[str, Any], ...] = ()
+    # A quiz question's answer as the student gave it (None: not answered).
+    answer: Any = None
 
     def __post_init__(self) -> None:
         # What a test says may quote a program's output: every format shows it harmless.
@@ -68,6 +74,12 @@ class TestResult:
     @property
     def passed(self) -> bool:
         return self.status == "passed"
+
+    @property
+    def module(self) -> str:
+        """The test module's file name, as the world's recordings are keyed
+        (``tests/public/test_governor.py::test_clamps`` -> ``test_governor.py``)."""
+        return self.nodeid.partition("::")[0].rpartition("/")[2]
 
     @property
     def student_message(self) -> str:
@@ -125,13 +137,10 @@ def _show_visible(result: object, *fields: str) -> None:
             object.__setattr__(result, name, visible(value))
 
 
-_RUN_DATA = ("isolation", "pacing", "bags", "warnings", "timing", "memory")
-"""What :meth:`RunResult.to_dict` writes from ``data``, and ``from_dict`` reads back."""
-
-
 @dataclasses.dataclass(frozen=True)
 class RunResult:
-    """A whole grading run: what every renderer is a pure function of."""
+    """A whole grading run: what every renderer is a pure function of. The fields after
+    ``not_run`` say how an exercise's grading ran; a quiz leaves them empty."""
 
     kind: Kind
     id: str
@@ -143,16 +152,52 @@ class RunResult:
     grader_details: str = ""
     log_tail: str = ""
     execution_time: float = 0.0
-    data: dict[str, Any] = dataclasses.field(default_factory=dict)
     # Every student program's output as the sandbox kept it (up to its output budget
     # each): for the HTML report and the log file beside the results, never in the JSON.
     log: str = ""
     # Set for a partial run (``check``): what the grade runs beyond it. A partial run
     # proves nothing about passing, so it never says passed.
     not_run: NotRun | None = None
+    # -- in the JSON results (see to_dict) --
+    # How the student's program was contained: ``Isolation.to_dict()`` with its ``bounds``
+    # and ``student_uids``; None when nothing was started (a fault before the run).
+    isolation: Mapping[str, Any] | None = None
+    # How the world paced itself, per test module (``sim.bridge``).
+    pacing: Mapping[str, Mapping[str, Any]] = dataclasses.field(default_factory=dict)
+    # ``--record DIR``: each test module's rosbag2 bag folder.
+    bags: Mapping[str, str] = dataclasses.field(default_factory=dict)
+    # What the student should know that is no test's verdict (a recording that failed).
+    warnings: tuple[str, ...] = ()
+    # Where the wall seconds went (``autograder.plugin.timing``) and the memory.
+    timing: Mapping[str, Any] = dataclasses.field(default_factory=dict)
+    memory: Mapping[str, float] = dataclasses.field(default_factory=dict)
+    # The other users whose programs disturbed each grading done again before this one.
+    disturbed: tuple[tuple[int, ...], ...] = ()
+    # -- for the grader and the reports only --
+    recordings: Mapping[str, Mapping[str, Any]] = dataclasses.field(default_factory=dict)
+    domains: tuple[int, ...] = ()
+    processes: tuple[Mapping[str, Any], ...] = ()
+    student_uids: tuple[int, ...] | None = None
+    strangers: tuple[int, ...] = ()  # other users' programs seen on the grading's domains
+    startup_seconds: tuple[float, ...] = ()
+    timed_out: bool = False
+    silent: bool = False  # the student's programs ran and printed nothing at all
+    refused: bool = False  # the file was refused before any test ran
+    forged: bool = False  # the report was overwritten during the run
+    pass_summary: str = ""  # a quiz's: what passing takes, in the student's language
 
     def __post_init__(self) -> None:
         _show_visible(self, "log", "log_tail", "grader_details")
+
+    @property
+    def domain(self) -> int | None:
+        """The ROS domain of the grading (its first child's), None if none was taken."""
+        return self.domains[0] if self.domains else None
+
+    @property
+    def student_uid(self) -> int | None:
+        """The user the student's programs ran as (the first child's), None: the grader's."""
+        return self.student_uids[0] if self.student_uids else None
 
     @property
     def complete(self) -> bool:
@@ -195,11 +240,15 @@ class RunResult:
                        hint=t.get("hint", ""), visibility=t.get("visibility", "visible"),
                        reveal=t.get("reveal", "message"), core=t.get("core", False))
             for t in data["tests"])
+        isolation = data.get("isolation")
         return cls(kind=kind, id=data[kind], title=data.get("title", ""), tests=tests,
                    pass_mark=exact(data.get("pass_mark", "0.7")), lang=data.get("lang", "en"),
                    grader_error=data.get("grader_error"),
                    execution_time=data.get("execution_time", 0.0),
-                   data={key: data[key] for key in _RUN_DATA if key in data},
+                   isolation=isolation, pacing=data.get("pacing", {}),
+                   bags=data.get("bags", {}), warnings=tuple(data.get("warnings", ())),
+                   timing=data.get("timing", {}), memory=data.get("memory", {}),
+                   disturbed=tuple(tuple(uids) for uids in data.get("disturbed", ())),
                    not_run=NotRun.from_dict(data["not_run"]) if data.get("not_run") else None)
 
     def to_dict(self) -> dict[str, Any]:
@@ -218,18 +267,14 @@ class RunResult:
             "lang": self.lang,
             "grader_error": self.grader_error,
             "execution_time": round(self.execution_time, 3),
-            **({"isolation": self.data["isolation"]} if "isolation" in self.data else {}),
-            # How the world paced itself per test module (see sim/bridge.py): for instructors
-            # asking whether a verdict came from a slow node or a starved one.
-            **({"pacing": self.data["pacing"]} if self.data.get("pacing") else {}),
-            # `--record DIR`: each test module's rosbag2 bag, and what kept one from being made.
-            **({"bags": self.data["bags"]} if self.data.get("bags") else {}),
-            **({"warnings": self.data["warnings"]} if self.data.get("warnings") else {}),
-            # Whose programs disturbed the gradings done again before this one (issue 29).
-            **({"disturbed": self.data["disturbed"]} if self.data.get("disturbed") else {}),
-            # Where the wall seconds and the memory went (autograder/plugin/timing.py).
-            **({"timing": self.data["timing"]} if self.data.get("timing") else {}),
-            **({"memory": self.data["memory"]} if self.data.get("memory") else {}),
+            **({"isolation": dict(self.isolation)} if self.isolation is not None else {}),
+            **({"pacing": dict(self.pacing)} if self.pacing else {}),
+            **({"bags": dict(self.bags)} if self.bags else {}),
+            **({"warnings": list(self.warnings)} if self.warnings else {}),
+            **({"disturbed": [list(uids) for uids in self.disturbed]}
+               if self.disturbed else {}),
+            **({"timing": dict(self.timing)} if self.timing else {}),
+            **({"memory": dict(self.memory)} if self.memory else {}),
             "tests": [
                 {
                     "name": t.name,

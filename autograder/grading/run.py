@@ -4,7 +4,7 @@ a :class:`~autograder.core.results.RunResult`.
 The tests (and the world and probe they use) run in child processes, so a crash there is
 reported as a grader fault instead of taking the CLI down, and a run past its time limit
 is stopped with everything it started.  Test modules run in several children at once,
-each on a ROS domain of its own (:mod:`autograder.grading.modules`), so a grading takes
+each on a ROS domain of its own (:mod:`autograder.grading.module_groups`), so a grading takes
 about as long as its slowest module.
 """
 
@@ -28,7 +28,13 @@ from autograder.grading import children
 from autograder.grading.capacity import machine_cores
 from autograder.grading.children import Progress, Watchers
 from autograder.grading.footprint import Footprint
-from autograder.grading.modules import ModuleJobs, children_for, find_modules, merge, share_out
+from autograder.grading.module_groups import (
+    ModuleJobs,
+    children_for,
+    find_modules,
+    merge,
+    share_out,
+)
 from autograder.i18n import _, get_language
 from autograder.sandbox.domains import DomainLock, NoDomain, bound_on_domains, hold_domain
 from autograder.sandbox.isolation import (
@@ -59,22 +65,22 @@ def grade(exercise: Exercise, submission: Path | None, *, hidden: bool = True,
     of ours sets ``grader_error``.  ``progress`` gets each test as it finishes;
     ``running``, a few times a second, the tests that run now (one per child).
     With ``record``, each test module's graph is recorded as a rosbag2 bag in that folder
-    (``data["bags"]``); a recording that fails is only a warning (``data["warnings"]``).
+    (``bags``); a recording that fails is only a warning (``warnings``).
     ``module_jobs`` children run the test modules at once, each on a domain of its own
     (``auto``: one per module as far as the cores go); a given ``domain`` means one child.
     """
-    disturbed: list[list[int]] = []
+    disturbed: list[tuple[int, ...]] = []
     while True:
         result = _grade_once(exercise, submission, hidden=hidden, domain=domain,
                              real_time_factor=real_time_factor, progress=progress,
                              running=running, record=record, module_jobs=module_jobs)
-        strangers = result.data.get("strangers") or []
+        strangers = result.strangers
         if result.grader_error is None or not strangers or len(disturbed) >= REGRADES:
             break
         disturbed.append(strangers)  # what it saw proves nothing: again, once they left
-        _wait_until_gone(strangers, result.data.get("domains") or [], exercise.time_limit)
+        _wait_until_gone(strangers, result.domains, exercise.time_limit)
     if disturbed:
-        result = dataclasses.replace(result, data={**result.data, "disturbed": disturbed})
+        result = dataclasses.replace(result, disturbed=tuple(disturbed))
     return result
 
 
@@ -117,19 +123,16 @@ def _grade_once(exercise: Exercise, submission: Path | None, *, hidden: bool,
     except NoDomain as exc:
         return _fault(exercise, str(exc), time.monotonic() - started)
     if warnings:
-        result = dataclasses.replace(result, data={
-            **result.data, "warnings": warnings + result.data.get("warnings", [])})
+        result = dataclasses.replace(result, warnings=(*warnings, *result.warnings))
     # Where each ran on this machine is the reaping's business, not the results'.
     processes = [{k: v for k, v in p.items() if k != "workdir"} for p in raw.processes]
     bounds = processes[0].get("bounds") if processes else None
-    first = locks[0].domain
     # Each child's students run as the user of its domain.
     uids = [student_uid(lock.domain) for lock in locks] if isolation.own_user else None
-    return dataclasses.replace(result, data={
-        **result.data,
-        "isolation": {**isolation.to_dict(), "bounds": bounds, "student_uids": uids},
-        "domain": first, "domains": [lock.domain for lock in locks], "processes": processes,
-        "student_uid": uids[0] if uids else None, "student_uids": uids})
+    return dataclasses.replace(
+        result, isolation={**isolation.to_dict(), "bounds": bounds, "student_uids": uids},
+        domains=tuple(lock.domain for lock in locks), processes=tuple(processes),
+        student_uids=tuple(uids) if uids else None)
 
 
 def _more_domains(stack: contextlib.ExitStack, count: int) -> list[DomainLock]:
@@ -248,15 +251,14 @@ def _run(exercise: Exercise, submission: Path | None, plan: _Plan,
     result = _result(exercise, raw, ended, elapsed, all_tests=plan.all_tests)
     timing = _timing(raw.data, min(e.launched for e in ended), elapsed)
     memory = _memory(raw.data.get("memory"), footprint.peak_mb)
-    return dataclasses.replace(result, data={
-        **result.data, "timing": {**timing, "children": len(ended)},
-        **({"memory": memory} if memory else {})}), raw
+    return dataclasses.replace(result, timing={**timing, "children": len(ended)},
+                               memory=memory), raw
 
 
 def _memory(children_peaks: dict[str, float] | None,
             footprint_mb: float | None) -> dict[str, float]:
     """The results' ``memory``: the children's peak resident sizes, summed (an upper bound,
-    see :func:`autograder.grading.modules.merge`), and ``footprint_mb``, the peak of the
+    see :func:`autograder.grading.module_groups.merge`), and ``footprint_mb``, the peak of the
     whole grading's summed PSS as sampled (:mod:`autograder.grading.footprint`), if any
     sample was taken."""
     memory = dict(children_peaks or {})
@@ -298,9 +300,7 @@ def result_of(raw: RawTest, status: str | None = None,
         max_score=max_score, status=status,  # type: ignore[arg-type]
         message=raw.message if message is None else message, hint=raw.hint,
         visibility=raw.visibility, reveal=raw.reveal,  # type: ignore[arg-type]
-        details=raw.details, core=raw.core,
-        # The test module names the world's recording it ran in (report pictures).
-        data={"charts": raw.charts, "nodeid": raw.nodeid, "module": _module_of(raw.nodeid)})
+        details=raw.details, core=raw.core, nodeid=raw.nodeid, charts=tuple(raw.charts))
 
 
 def _score(status: str, max_score: Fraction, fraction: float | None) -> Fraction:
@@ -336,10 +336,9 @@ def _refused(exercise: Exercise, message: str, elapsed: float) -> RunResult:
         hint=_("Nothing was graded: fix this, then check again."))
     return RunResult(kind="exercise", id=exercise.id, title=exercise.localized_title,
                      tests=(test,), pass_mark=exercise.pass_fraction, lang=get_language(),
-                     execution_time=elapsed, data={
-                         "refused": True,  # nothing ran; the shape it would have run in:
-                         "isolation": {**detect().to_dict(), "bounds": None,
-                                       "student_uids": None}})
+                     execution_time=elapsed, refused=True,
+                     # nothing ran; the shape it would have run in:
+                     isolation={**detect().to_dict(), "bounds": None, "student_uids": None})
 
 
 def _forged(exercise: Exercise, elapsed: float) -> RunResult:
@@ -352,13 +351,7 @@ def _forged(exercise: Exercise, elapsed: float) -> RunResult:
         hint=_("A program must not write outside its working directory."))
     return RunResult(kind="exercise", id=exercise.id, title=exercise.localized_title,
                      tests=(test,), pass_mark=exercise.pass_fraction, lang=get_language(),
-                     execution_time=elapsed, data={"forged": True})
-
-
-def _module_of(nodeid: str) -> str:
-    """The test module's file name, as the world's recordings are keyed
-    ("tests/public/test_governor.py::test_clamps" -> "test_governor.py")."""
-    return nodeid.partition("::")[0].rpartition("/")[2]
+                     execution_time=elapsed, forged=True)
 
 
 def _result(exercise: Exercise, raw_report: RawReport, ended: Sequence[children.Ended],
@@ -404,14 +397,12 @@ def _result(exercise: Exercise, raw_report: RawReport, ended: Sequence[children.
         log_tail="\n".join(v for v in logs.values() if v.strip())[-4000:],
         log=raw_report.output_log, not_run=not_run,
         execution_time=elapsed,
-        data={"recordings": data.get("recordings", {}),
-              "timed_out": any(e.timed_out for e in ended),
-              "startup_seconds": data.get("startup_seconds", []),
-              "pacing": data.get("pacing", {}), "bags": data.get("bags", {}),
-              "warnings": data.get("warnings", []),
-              "strangers": sorted({uid for raw in raw_report.tests for uid in raw.strangers}),
-              # The student's programs ran and printed nothing at all: the report says so.
-              "silent": bool(logs) and not any(v.strip() for v in logs.values())})
+        recordings=data.get("recordings", {}), timed_out=any(e.timed_out for e in ended),
+        startup_seconds=tuple(data.get("startup_seconds", ())),
+        pacing=data.get("pacing", {}), bags=data.get("bags", {}),
+        warnings=tuple(data.get("warnings", ())),
+        strangers=tuple(sorted({uid for raw in raw_report.tests for uid in raw.strangers})),
+        silent=bool(logs) and not any(v.strip() for v in logs.values()))
 
 
 def _not_run(exercise: Exercise, counted: dict[str, Any] | None,

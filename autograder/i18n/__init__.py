@@ -16,7 +16,8 @@ import os
 from functools import cache
 from pathlib import Path
 
-import sim.i18n
+import content.i18n
+from content.course import course_root
 
 DOMAIN = "messages"
 LANGUAGES = ("en", "ur")
@@ -30,8 +31,6 @@ def locales_dir() -> Path:
     env = os.environ.get("AUTOGRADER_LOCALES")
     if env:
         return Path(env)
-    from autograder.core.course import course_root
-
     return course_root() / "locales"
 
 
@@ -54,19 +53,20 @@ def translations(lang: str, domain: str = DOMAIN) -> _gettext.NullTranslations:
     """Translations for ``lang`` in ``domain``; English (the source) is a null catalog."""
     if lang == "en":
         return _gettext.NullTranslations()
-    return sim.i18n.load_catalog(catalog_folder(lang, domain), lang, domain)
+    return content.i18n.load_catalog(catalog_folder(lang, domain), lang, domain)
 
 
 def set_language(lang: str) -> None:
     """Make ``lang`` the language of every later ``_`` call in this process, the
-    simulator's messages included (``sim`` binds its own ``_``: it imports nothing of
-    ``autograder``)."""
+    simulator's and the content files' messages included (:mod:`content.i18n` binds their
+    ``_``: they import nothing of ``autograder``)."""
     global _active
     _active = lang
     from autograder.i18n import click_words
 
     click_words.speak()
-    sim.i18n.set_language(lang, lambda: catalog_folder(sim.i18n.get_language()).parent.parent)
+    content.i18n.set_language(
+        lang, lambda: catalog_folder(content.i18n.get_language()).parent.parent)
 
 
 def get_language() -> str:

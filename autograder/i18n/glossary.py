@@ -23,12 +23,13 @@ from typing import Literal
 
 from babel.messages.catalog import Catalog, Message
 
-from autograder.core.errors import ContentError
-from autograder.i18n import _, rules
-from autograder.i18n.tools import Problem, read_catalog
-from sim.content import Document, build, load_document
+from autograder.i18n import LANGUAGES, _, rules
+from autograder.i18n.tools import Problem, check_catalog, read_catalog
+from content import ContentError, Document, build, load_document
 
 GLOSSARY_FILE = "glossary.yaml"
+TRANSLATIONS = tuple(lang for lang in LANGUAGES if lang != "en")
+"""The languages translated from English: what ``i18n check`` checks by default."""
 
 # What a checked text is stripped of before matching: code spans and fenced code are code;
 # placeholders become a number (so "{seconds} s" reads as a number and a unit); quoted
@@ -497,3 +498,17 @@ def exercise_title(catalog: Catalog | None, exercise: str) -> str | None:
         if message.context == f"exercise:{exercise}:title" and message.string:
             return str(message.string)
     return None
+
+
+def check_all(locales: Path, langs: tuple[str, ...] = TRANSLATIONS,
+              root: Path | None = None) -> list[Problem]:
+    """What ``i18n check`` finds: each template's entries translated in each language, and
+    the language rules (glossary, grammar, READMEs) of :func:`check_language`."""
+    problems: list[Problem] = []
+    for template in sorted(locales.glob("*.pot")):
+        for lang in langs:
+            po = locales / lang / "LC_MESSAGES" / f"{template.stem}.po"
+            problems += check_catalog(template, po, lang)
+    for lang in langs:
+        problems += check_language(locales, lang, root)
+    return problems

@@ -20,8 +20,8 @@ from babel.messages.frontend import parse_mapping_cfg
 from babel.messages.mofile import write_mo
 from babel.messages.pofile import PoFileError, read_po, write_po
 
-from autograder.core.errors import ContentError
 from autograder.i18n import _
+from content import ContentError
 
 PLATFORM_DOMAIN = "messages"
 CONTENT_DOMAIN = "content"

@@ -55,7 +55,7 @@ def open_bag(request: pytest.FixtureRequest, bridge: SimBridge,
         recorder = BagRecorder(folder, mount=getattr(bridge.sim.lidar, "mount", (0.0, 0.0, 0.0)),
                                custom_data={"exercise": Path(settings.exercise).name,
                                             "test_module": request.node.nodeid, "world": world})
-    except Exception as exc:  # noqa: BLE001 - no recording is no reason to fail a test
+    except Exception as exc:  # no recording is no reason to fail a test
         _warn(request, [_("The run could not be recorded in {path}: {error}").format(
             path=folder, error=exc)])
         return None

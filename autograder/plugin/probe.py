@@ -175,7 +175,7 @@ class Probe:
     def _spin(self) -> None:
         try:
             self._executor.spin()
-        except Exception:  # noqa: BLE001 - the context shutting down ends the spin
+        except Exception:  # the context shutting down ends the spin
             pass
 
     def close(self) -> None:

@@ -15,7 +15,7 @@ import pytest
 
 from autograder.core import report
 from autograder.core.errors import Disturbed, GraderError, StudentFailure
-from autograder.core.output import (
+from autograder.core.output_budget import (
     DETAILS_BYTES,
     LOG_TAIL_BYTES,
     LOG_TAIL_LINES,

@@ -13,13 +13,19 @@ from typing import TYPE_CHECKING, Any
 import pytest
 
 from autograder.core.errors import StudentFailure
-from autograder.core.output import TAIL_BYTES, TAIL_LINES, describe_exit, message_tail, size_note
+from autograder.core.output_budget import (
+    TAIL_BYTES,
+    TAIL_LINES,
+    describe_exit,
+    message_tail,
+    size_note,
+)
 from autograder.core.untrusted import visible
 from autograder.i18n import _
+from autograder.plugin.graph import node_endpoints, wait_until_up
 from autograder.plugin.probe import GRADER_NODES
 from autograder.plugin.stash import reporter_key, settings_key, startup_key
 from autograder.plugin.timing import Timing, module_of
-from autograder.sandbox.graph import node_endpoints, wait_until_up
 from sim.procstate import runqueue_wait_ns
 
 if TYPE_CHECKING:

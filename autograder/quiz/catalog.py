@@ -5,12 +5,12 @@ from __future__ import annotations
 import dataclasses
 from pathlib import Path
 
-from autograder.core.course import course_root
 from autograder.core.errors import ContentError
 from autograder.core.names import unknown_quiz
 from autograder.i18n import content_text
 from autograder.quiz.model import QuizFile, context, load_quiz
-from sim.content import load_document
+from content import load_document
+from content.course import course_root
 
 
 @dataclasses.dataclass(frozen=True)

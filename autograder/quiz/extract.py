@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import IO, Any
 
 from autograder.quiz.model import load_quiz, strings
-from sim.content import load_document
+from content import load_document
 
 Extracted = tuple[int, str, tuple[str, str], list[str]]
 EXERCISE_FIELDS = ("title", "summary")

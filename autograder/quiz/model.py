@@ -19,7 +19,7 @@ from autograder.core.errors import ContentError
 from autograder.core.results import exact
 from autograder.i18n import _
 from autograder.quiz.types import question_type, registry
-from sim.content import Document, build, load_document
+from content import Document, build, load_document
 
 ID_PATTERN = re.compile(r"^[a-z0-9][a-z0-9_-]*$")
 

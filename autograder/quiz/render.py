@@ -11,52 +11,22 @@ import json
 from collections.abc import Mapping
 from typing import Any
 
-import jinja2
-from markupsafe import Markup
-
 from autograder.core.results import RunResult
-from autograder.i18n import _, is_rtl, ngettext
-from autograder.quiz.localize import (
-    Localizer,
+from autograder.i18n import _, is_rtl
+from autograder.i18n.templates import environment
+from autograder.i18n.text import (
     Text,
     format_number,
     format_percent,
     markdown_inline,
     plain,
-    rich,
-    sentence,
     using_language,
-    with_output,
 )
+from autograder.quiz.localize import Localizer
 from autograder.quiz.model import Quiz
 from autograder.quiz.scoring import pass_summary
 from autograder.quiz.types import question_type
 from autograder.quiz.views import question_views
-
-FONT_STACK_UR = ('"Noto Nastaliq Urdu", "Jameel Noori Nastaleeq", "Urdu Typesetting", '
-                 '"Noto Naskh Arabic", serif')
-# Latin runs inside Urdu (``:lang(en)``): Nastaliq fonts have digits but no Latin letters,
-# so left to the Urdu stack a run would mix a fallback serif with Nastaliq digits.
-FONT_STACK_LATIN = '"Noto Sans", "DejaVu Sans", system-ui, sans-serif'
-
-
-def _environment() -> jinja2.Environment:
-    env = jinja2.Environment(
-        loader=jinja2.PackageLoader("autograder", "templates"),
-        autoescape=jinja2.select_autoescape(["html"], default=True),
-        trim_blocks=True, lstrip_blocks=True, undefined=jinja2.StrictUndefined)
-    env.globals.update(_=_, ngettext=ngettext, font_stack_ur=Markup(FONT_STACK_UR),
-                       font_stack_latin=Markup(FONT_STACK_LATIN))
-    env.filters.update(rich=rich, plain=plain, bidi=sentence, with_output=with_output)
-    return env
-
-
-_ENV = _environment()
-
-
-def environment() -> jinja2.Environment:
-    """The autoescaped template environment shared by quiz pages and grading reports."""
-    return _ENV
 
 
 def _page_context(quiz: Quiz, lang: str) -> dict[str, Any]:
@@ -79,7 +49,7 @@ def render_page(quiz: Quiz, lang: str, seed: str | int | None = None,
     ``given`` (a submitted form) fills the answers back in; ``problems`` says at each
     question id why what was entered is no answer."""
     with using_language(lang):
-        return _ENV.get_template("quiz.html").render(
+        return environment().get_template("quiz.html").render(
             **_page_context(quiz, lang), questions=question_views(quiz, lang, seed),
             seed="" if seed is None else str(seed), action=action,
             languages=languages or quiz.languages, given=given or {},
@@ -95,7 +65,7 @@ def render_result(quiz: Quiz, result: RunResult, answers: Mapping[str, Any],
     if seed is not None:
         saved["seed"] = seed
     with using_language(lang):
-        return _ENV.get_template("quiz_result.html").render(
+        return environment().get_template("quiz_result.html").render(
             **_page_context(quiz, lang), result=result,
             score=format_number(result.score, lang),
             max_score=format_number(result.max_score, lang),
@@ -114,7 +84,7 @@ def _feedback(quiz: Quiz, result: RunResult
     for t in result.tests:
         q = quiz.question(t.name)
         assert q is not None, t.name
-        given = t.data.get("answer")
+        given = t.answer
         answer = None if given is None else Text(
             question_type(q.type).answer_text(quiz, q, given, loc), result.lang)
         rows.append((t, loc.text(q, "text"),
@@ -126,7 +96,7 @@ def render_index(quizzes: list[Quiz], lang: str, languages: tuple[str, ...]) -> 
     """The server's home page: pick a language and a quiz."""
     with using_language(lang):
         items = [(q, Localizer(q, lang).quiz_text("title")) for q in quizzes]
-        return _ENV.get_template("quiz_index.html").render(
+        return environment().get_template("quiz_index.html").render(
             lang=lang, dir="rtl" if is_rtl(lang) else "ltr", items=items,
             languages=languages, title=Text(_("Quizzes"), lang))
 

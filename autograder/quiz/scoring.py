@@ -17,7 +17,8 @@ from typing import Any
 from autograder.core.errors import ContentError
 from autograder.core.results import RunResult, TestResult
 from autograder.i18n import _, ngettext
-from autograder.quiz.localize import Localizer, format_number, format_percent, using_language
+from autograder.i18n.text import format_number, format_percent, using_language
+from autograder.quiz.localize import Localizer
 from autograder.quiz.model import Quiz
 from autograder.quiz.types import question_type
 
@@ -125,16 +126,16 @@ def _score(quiz: Quiz, answers: Mapping[str, Any], lang: str) -> RunResult:
             status="passed" if earned == points else "failed",
             message=kind.feedback(q, value, earned, lang),
             hint=loc.text(q, "explanation").value if q.explanation else "",
-            data={"answer": value}))
+            answer=value))
     return RunResult(kind="quiz", id=quiz.id, title=loc.quiz_text("title").value,
                      tests=tuple(tests), pass_mark=quiz.exact_pass_mark, lang=lang,
-                     data={"pass_summary": pass_summary(quiz, lang)})
+                     pass_summary=pass_summary(quiz, lang))
 
 
 def result_dict(result: RunResult) -> dict[str, Any]:
     """The results JSON: the shared shape, plus the pass summary the chapter prints."""
     out = result.to_dict()
-    out["pass_summary"] = result.data.get("pass_summary", "")
+    out["pass_summary"] = result.pass_summary
     return out
 
 

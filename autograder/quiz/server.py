@@ -18,7 +18,7 @@ from markupsafe import escape
 
 from autograder.core.errors import ContentError
 from autograder.i18n import LANGUAGES, _
-from autograder.quiz.localize import using_language
+from autograder.i18n.text import using_language
 from autograder.quiz.model import Quiz, QuizFile
 from autograder.quiz.render import render_index, render_page, render_result
 from autograder.quiz.scoring import check_answers, score
@@ -57,7 +57,7 @@ class QuizServer(HTTPServer):
 class _Handler(BaseHTTPRequestHandler):
     server: QuizServer
 
-    def log_message(self, format: str, *args: Any) -> None:  # noqa: A002 - stdlib name
+    def log_message(self, format: str, *args: Any) -> None:  # stdlib name
         pass  # quiet: a student's terminal is not an access log
 
     def _send(self, status: HTTPStatus, body: str) -> None:
@@ -88,7 +88,7 @@ class _Handler(BaseHTTPRequestHandler):
             quiz = self.server.quizzes.get(segments[1])
         return quiz, "/".join(segments[2:]), query
 
-    def do_GET(self) -> None:  # noqa: N802 - http.server's name
+    def do_GET(self) -> None:  # http.server's name
         quiz, rest, query = self._route()
         lang = self._lang(query)
         with using_language(lang):
@@ -108,7 +108,7 @@ class _Handler(BaseHTTPRequestHandler):
                 self._error(HTTPStatus.INTERNAL_SERVER_ERROR,
                             _("The autograder failed, tell your instructor."), lang)
 
-    def do_POST(self) -> None:  # noqa: N802 - http.server's name
+    def do_POST(self) -> None:  # http.server's name
         quiz, rest, query = self._route()
         length = min(int(self.headers.get("Content-Length") or 0), 1_000_000)
         form = parse_qs(self.rfile.read(length).decode("utf-8", "replace"))

@@ -8,7 +8,8 @@ from __future__ import annotations
 
 import dataclasses
 
-from autograder.quiz.localize import Localizer, Text
+from autograder.i18n.text import Text
+from autograder.quiz.localize import Localizer
 from autograder.quiz.model import Quiz
 from autograder.quiz.types import question_type
 

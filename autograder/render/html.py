@@ -15,8 +15,8 @@ from typing import Any
 
 from autograder.core.results import RunResult, number
 from autograder.i18n import is_rtl
-from autograder.quiz.localize import Text, format_percent, using_language
-from autograder.quiz.render import environment
+from autograder.i18n.templates import environment
+from autograder.i18n.text import Text, format_percent, using_language
 from autograder.render import OutputFormat, replay
 from autograder.render.charts import intervals_svg
 from autograder.render.verdict import core_heading, core_label
@@ -39,7 +39,7 @@ def _tests(result: RunResult, lang: str) -> list[dict[str, Any]]:
             "charts": [{"svg": intervals_svg([tuple(p) for p in chart["points"]],
                                              chart.get("limit"), chart["title"]),
                         "limit": chart.get("limit") is not None}
-                       for chart in test.data.get("charts", []) if chart.get("points")],
+                       for chart in test.charts if chart.get("points")],
             "score": number(test.score), "max_score": number(test.max_score),
         })
     return tests

@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, Any
 from markupsafe import Markup
 
 from autograder.core.results import RunResult
-from autograder.quiz.localize import Text
+from autograder.i18n.text import Text
 
 if TYPE_CHECKING:  # sim is imported when a report is drawn, not with the renderers
     from sim.recorder import Recording
@@ -93,14 +93,14 @@ def figures(result: RunResult, exercise_folder: Path | None) -> list[Figure]:
 
     labels: dict[str, list[Text]] = {}
     for test in result.tests:
-        module = test.data.get("module")
+        module = test.module
         if module:
             labels.setdefault(module, []).append(Text(test.label, result.lang))
     worlds: dict[str, list[tuple[str, Recording, dict[str, Any]]]] = {}
-    for module, recorded in result.data.get("recordings", {}).items():
+    for module, recorded in result.recordings.items():
         try:
             recording = Recording.from_dict(recorded)
-        except Exception:  # noqa: BLE001 - a run we cannot read is left out
+        except Exception:  # a run we cannot read is left out
             continue
         if not recording.samples or recording.distance() < 0.05:
             continue  # the robot stood still: nothing to look at
@@ -110,7 +110,7 @@ def figures(result: RunResult, exercise_folder: Path | None) -> list[Figure]:
         local = exercise_folder / f"{name}.yaml" if exercise_folder else None
         try:
             spec = load_world(local if local and local.exists() else name)
-        except Exception:  # noqa: BLE001 - a picture we cannot draw is left out
+        except Exception:  # a picture we cannot draw is left out
             continue
         title = title_of(spec)  # in English when not translated: marked so
         english = result.lang != "en" and title in (spec.title, spec.name)

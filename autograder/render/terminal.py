@@ -13,14 +13,15 @@ from __future__ import annotations
 
 import re
 import unicodedata
-from collections.abc import Collection, Iterable
+from collections.abc import Collection, Iterable, Mapping
 from pathlib import Path
+from typing import Any
 
 from babel.numbers import format_percent
 
 from autograder.core.results import RunResult, TestResult, as_decimal, number
 from autograder.i18n import _, get_language, is_rtl, ngettext
-from autograder.quiz.localize import CODE_SPAN, LRI, PDI, ltr_runs
+from autograder.i18n.text import CODE_SPAN, LRI, PDI, ltr_runs
 from autograder.render.verdict import core_label, core_lines
 
 RLM = "\u200f"
@@ -190,7 +191,7 @@ def _bound(kind: str | None, cgroup: str | None, controller: str, rlimit: str) -
     return _("nothing (no writable cgroup, no user of its own)")
 
 
-def isolation_line(isolation: dict) -> str:
+def isolation_line(isolation: Mapping[str, Any]) -> str:
     """How the student's program was contained, and what bounded it, in one line."""
     bounds = isolation.get("bounds") or {}
     limits = _("processes bounded by {processes}, memory by {memory}").format(
@@ -211,7 +212,7 @@ def isolation_line(isolation: dict) -> str:
           "tests and change these results.")))
 
 
-def containment_sentence(isolation: dict) -> str:
+def containment_sentence(isolation: Mapping[str, Any]) -> str:
     """For students: in one sentence, whether their program was contained and why that
     matters (the grade stands for what their node did, and only that). The technical
     line (:func:`isolation_line`) is for instructors: ``--verbose`` and the JSON."""
@@ -233,7 +234,7 @@ def to_terminal(result: RunResult, color: bool = False, shown: Collection[str] =
     for block in failure_blocks(result.tests, color):
         lines += ["", block]
     lines += ["", *score_lines(result, color)]
-    isolation = result.data.get("isolation", {})
+    isolation = result.isolation
     if isolation:
         lines.append(isolation_line(isolation) if verbose else containment_sentence(isolation))
     if result.grader_error:
@@ -246,4 +247,4 @@ def to_terminal(result: RunResult, color: bool = False, shown: Collection[str] =
 
 def line_key(test: TestResult) -> str:
     """What tells a test from the others in a run (its node id when the run knows it)."""
-    return str(test.data.get("nodeid") or test.name)
+    return test.nodeid or test.name

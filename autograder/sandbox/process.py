@@ -1,7 +1,7 @@
 """Run a student's program as its own process, contained and bounded.
 
-Each program runs through :mod:`autograder.sandbox.launcher` in its own session and process
-group, in a throwaway working directory, with a minimal environment and resource limits.
+Each program runs through :mod:`autograder.sandbox.contained.launcher` in its own session
+and process group, in a throwaway working directory, with a minimal environment and resource limits.
 Where the machine lets us create cgroups (v1 ``pids`` and ``memory``), the program also
 runs in a cgroup of its own: that bounds processes even for root and lets :meth:`stop`
 find and kill everything it started, daemons that left the session included.
@@ -29,8 +29,8 @@ from typing import Any
 
 from autograder.core.errors import GraderError
 from autograder.core.exercise import Limits
-from autograder.sandbox import runner
 from autograder.sandbox.cgroups import Cgroup
+from autograder.sandbox.contained import runner
 from autograder.sandbox.privileged import PACKAGE_PARENT, SAFE_CWD, module_command
 from autograder.sandbox.sweep import is_student_uid, sweep_user
 
@@ -152,10 +152,10 @@ _zygotes_failed: set[tuple[str, ...]] = set()
 
 def warm_start(python: str, env: dict[str, str]) -> Any:
     """This process's zygote for programs run by ``python`` with ``env``
-    (:mod:`autograder.sandbox.zygote`), started at the first launch; None where launches
+    (:mod:`autograder.sandbox.contained.zygote`), started at the first launch; None where launches
     are exec'd: ``AUTOGRADER_ZYGOTE=0``, or a zygote for that interpreter and start-up
     environment that could not start or died in this process."""
-    from autograder.sandbox.zygote import STARTUP_VARIABLES, Zygote, ZygoteGone
+    from autograder.sandbox.contained.zygote import STARTUP_VARIABLES, Zygote, ZygoteGone
 
     if os.environ.get("AUTOGRADER_ZYGOTE", "1") == "0":
         return None
@@ -340,7 +340,7 @@ class StudentProcess:
               env: dict[str, str]) -> tuple[Any, int] | None:
         """The program forked from this process's zygote, and the read end of its status
         pipe; None where there is no zygote for it (then it is exec'd)."""
-        from autograder.sandbox.zygote import ZygoteGone
+        from autograder.sandbox.contained.zygote import ZygoteGone
 
         zygote = warm_start(student_python(), env)
         if zygote is None:
@@ -358,7 +358,7 @@ class StudentProcess:
         """The program started through the launcher, which execs it once contained."""
         status_read, status_write = os.pipe()
         spec = {**spec, "status_fd": status_write}
-        command = module_command("autograder.sandbox.launcher", [
+        command = module_command("autograder.sandbox.contained.launcher", [
             json.dumps(spec), "--", *runner.command(student_python(), str(self.script), args)])
         try:
             popen = subprocess.Popen(

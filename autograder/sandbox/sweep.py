@@ -21,7 +21,7 @@ import subprocess
 import sys
 import time
 
-from autograder.sandbox.launcher import process_statuses
+from autograder.sandbox.contained.launcher import process_statuses
 
 _KILL_ALL = "import os, signal; os.kill(-1, signal.SIGKILL)"
 

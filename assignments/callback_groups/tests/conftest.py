@@ -9,7 +9,7 @@ from std_msgs.msg import Float32
 
 sys.path.insert(0, str(Path(__file__).parent))
 
-from helpers import Requests  # noqa: E402
+from helpers import Requests
 
 
 @pytest.fixture(scope="module")

@@ -90,7 +90,7 @@ class Requests:
         def done(f: Any, a: Answer = answer) -> None:
             try:
                 response = None if f.cancelled() else f.result()
-            except Exception:  # noqa: BLE001 - a failed call is an answer that says nothing
+            except Exception:  # a failed call is an answer that says nothing
                 response = None
             with self._lock:
                 a.answered = self.probe.now

@@ -9,7 +9,7 @@ from std_msgs.msg import String
 
 sys.path.insert(0, str(Path(__file__).parent))
 
-from helpers import Streams, observe  # noqa: E402
+from helpers import Streams, observe
 
 
 @pytest.fixture(scope="module")

@@ -12,7 +12,8 @@ from collections.abc import Callable, Sequence
 
 from autograder.core.errors import ContentError
 from autograder.i18n import _
-from autograder.quiz.localize import Localizer, Text, using_language
+from autograder.i18n.text import Text, using_language
+from autograder.quiz.localize import Localizer
 from autograder.quiz.model import Question, QuizFile
 
 FORMATS = ("moodle-xml", "qti")

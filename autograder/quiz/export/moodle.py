@@ -24,9 +24,10 @@ from html import escape
 
 from autograder.core.errors import ContentError
 from autograder.i18n import _, get_language
+from autograder.i18n.text import Text, format_number, format_percent, rich
 from autograder.quiz.export.common import Languages
 from autograder.quiz.export.xml import CData, El, el, to_xml
-from autograder.quiz.localize import Localizer, Text, format_number, format_percent, rich
+from autograder.quiz.localize import Localizer
 from autograder.quiz.model import Question, QuizFile
 from autograder.quiz.scoring import pass_summary
 from autograder.quiz.types import question_type

@@ -31,18 +31,10 @@ from fractions import Fraction
 from autograder.core.errors import ContentError
 from autograder.core.results import exact
 from autograder.i18n import is_rtl
+from autograder.i18n.text import CODE_SPAN, LRI, PDI, Text, isolate_runs, plain, using_language
 from autograder.quiz.export.common import Languages, paragraphs
 from autograder.quiz.export.xml import El, el, to_xml
-from autograder.quiz.localize import (
-    CODE_SPAN,
-    LRI,
-    PDI,
-    Localizer,
-    Text,
-    isolate_runs,
-    plain,
-    using_language,
-)
+from autograder.quiz.localize import Localizer
 from autograder.quiz.model import Question, QuizFile
 from autograder.quiz.scoring import pass_summary
 from autograder.quiz.types import question_type

@@ -14,11 +14,12 @@ from fractions import Fraction
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from autograder.i18n import _, ngettext, pgettext
-from autograder.quiz.localize import Localizer, format_number, terminal
+from autograder.i18n.text import format_number, terminal
+from autograder.quiz.localize import Localizer
 from autograder.quiz.model import Option, Question, Quiz, check_id
 from autograder.quiz.shuffle import attempt_rng, shuffle_unpinned
 from autograder.quiz.views import OptionView, QuestionView
-from sim.content import Document
+from content import Document
 
 if TYPE_CHECKING:  # the exports build on the types: imported only for annotations
     from autograder.quiz.export.moodle import MoodleWriter

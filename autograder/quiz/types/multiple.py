@@ -10,7 +10,7 @@ from fractions import Fraction
 from typing import TYPE_CHECKING, Any
 
 from autograder.i18n import N_, _
-from autograder.quiz.localize import markdown_inline
+from autograder.i18n.text import markdown_inline
 from autograder.quiz.model import Question
 from autograder.quiz.types import register
 from autograder.quiz.types.base import (
@@ -22,7 +22,7 @@ from autograder.quiz.types.base import (
     picked_ids,
 )
 from autograder.quiz.views import QuestionView
-from sim.content import Document
+from content import Document
 
 if TYPE_CHECKING:
     from autograder.quiz.export.moodle import MoodleWriter

@@ -14,12 +14,13 @@ from babel.numbers import format_decimal
 
 from autograder.core.results import exact
 from autograder.i18n import N_, _
-from autograder.quiz.localize import Localizer, babel_locale, markdown_inline, terminal
+from autograder.i18n.text import babel_locale, markdown_inline, terminal
+from autograder.quiz.localize import Localizer
 from autograder.quiz.model import Question, Quiz
 from autograder.quiz.types import register
 from autograder.quiz.types.base import Form, LintNote, QuestionType, Where, first_value
 from autograder.quiz.views import QuestionView
-from sim.content import Document
+from content import Document
 
 if TYPE_CHECKING:
     from autograder.quiz.export.moodle import MoodleWriter

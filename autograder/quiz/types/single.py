@@ -6,7 +6,7 @@ from fractions import Fraction
 from typing import TYPE_CHECKING, Any
 
 from autograder.i18n import _
-from autograder.quiz.localize import markdown_inline
+from autograder.i18n.text import markdown_inline
 from autograder.quiz.model import Question
 from autograder.quiz.types import register
 from autograder.quiz.types.base import (
@@ -18,7 +18,7 @@ from autograder.quiz.types.base import (
     one_picked_id,
 )
 from autograder.quiz.views import QuestionView
-from sim.content import Document
+from content import Document
 
 if TYPE_CHECKING:
     from autograder.quiz.export.moodle import MoodleWriter

@@ -11,13 +11,14 @@ from fractions import Fraction
 from typing import TYPE_CHECKING, Any
 
 from autograder.i18n import _
-from autograder.quiz.localize import Localizer, Text
+from autograder.i18n.text import Text
+from autograder.quiz.localize import Localizer
 from autograder.quiz.model import Question, Quiz
 from autograder.quiz.types import register
 from autograder.quiz.types.base import Where, one_option_problem
 from autograder.quiz.types.single import SingleChoice
 from autograder.quiz.views import OptionView
-from sim.content import Document
+from content import Document
 
 if TYPE_CHECKING:
     from autograder.quiz.export.moodle import MoodleWriter

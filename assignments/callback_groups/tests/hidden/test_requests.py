@@ -45,7 +45,7 @@ def test_ignores_invalid_readings(student, probe, scans, world, alive):
         probe.wait_sim(0.3)
         answer = ask(probe)
         judge(answer, scan_after(probe, scans, answer.sent),
-              _("With 15% of the beams each NaN, +inf, -inf and below range_min"))
+              _("With 15 percent of the beams each NaN, +inf, -inf and below range_min"))
     finally:  # the next test starts with clean scans, whatever happened here
         probe.wait_for(lambda: probe.now > start + 2.0, 3.0)
 

@@ -69,7 +69,7 @@ def build(node):
         state.last_scan_ns = node.get_clock().now().nanoseconds
         try:
             linear, angular, state.turning = decide(scan, state.turning)
-        except Exception as exc:  # noqa: BLE001 - a bad scan must not end the node
+        except Exception as exc:  # a bad scan must not end the node
             node.get_logger().error(f'could not use a scan: {exc!r}')
             linear = angular = 0.0
         state.verdict = (linear, angular)

@@ -35,7 +35,7 @@ class ObstacleAvoider(Node):
                 command = Twist()
             else:
                 command = self.steer(self.scan)
-        except Exception:  # noqa: BLE001 - any failure means: stop, say why, go on
+        except Exception:  # any failure means: stop, say why, go on
             self.get_logger().error('control cycle failed; stopping')
             command = Twist()
         self.publisher.publish(command)

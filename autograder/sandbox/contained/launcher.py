@@ -3,7 +3,7 @@
 Runs as a fresh single-threaded process (so no ``preexec_fn`` runs in the threaded
 grader) and ``exec``s the student's command once it is contained::
 
-    python -m autograder.sandbox.launcher SPEC_JSON -- COMMAND...
+    python -m autograder.sandbox.contained.launcher SPEC_JSON -- COMMAND...
 
 SPEC holds ``limits`` (see ``autograder.core.exercise.Limits``), ``cgroups`` (folders to
 join), ``workdir`` (where the program runs) and ``status_fd``, and for strict isolation
@@ -261,7 +261,8 @@ def interpreter_paths() -> list[str]:
     """What the student's Python needs to run here: the interpreter, its environment, and
     every folder on its module path (a venv's site-packages, a system ROS install's), but
     not this platform's own checkout, whose way onto the path is the launcher's."""
-    own = os.path.realpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
+    own = os.path.realpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..",
+                                        ".."))
     here = os.path.realpath(os.getcwd())
     found = [sys.prefix, sys.base_prefix, sys.exec_prefix,
              os.path.dirname(os.path.realpath(sys.executable))]
@@ -319,7 +320,7 @@ def main(argv: list[str]) -> None:
         contain(spec, stage)
         stage[0] = f"exec {command[0]}"
         os.execvp(command[0], command)
-    except BaseException as exc:  # noqa: BLE001 - every failure before the exec is ours
+    except BaseException as exc:  # every failure before the exec is ours
         report = json.dumps({"stage": stage[0], "error": f"{type(exc).__name__}: {exc}"})
         if status_fd is None:
             print(report, file=sys.stderr)

@@ -1,12 +1,13 @@
-"""``_`` and ``N_`` for the simulator's own messages, in the platform's active language.
+"""``_`` and ``N_`` for the simulator's and the content files' messages, in the platform's
+active language.
 
-``sim`` is the lowest layer and imports nothing of ``autograder``, so it binds gettext
-itself, over the same ``messages`` catalogs (``locales/<lang>/LC_MESSAGES/messages.po``)
-that ``autograder i18n extract`` fills from ``sim/**.py`` too (babel.cfg).  Whoever embeds
-the simulator says which language and where the ``locales/`` folder is:
-``autograder.i18n`` calls :func:`set_language` whenever its own language changes, with
-its own way of finding the folder.  ``AUTOGRADER_LOCALES`` overrides the folder, as it
-does for the platform.
+``sim`` and ``content`` import nothing of ``autograder``, so they bind gettext here, over
+the same ``messages`` catalogs (``locales/<lang>/LC_MESSAGES/messages.po``) that
+``autograder i18n extract`` fills from ``sim/**.py`` and ``content/**.py`` too
+(babel.cfg).  Whoever embeds the simulator says which language and where the
+``locales/`` folder is: ``autograder.i18n`` calls :func:`set_language` whenever its own
+language changes, with its own way of finding the folder.  ``AUTOGRADER_LOCALES``
+overrides the folder, as it does for the platform.
 
 A compiled ``.mo`` is used when it is at least as new as its ``.po``; otherwise the
 ``.po`` is compiled in memory with Babel, so a fresh clone needs no build step.

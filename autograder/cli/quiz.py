@@ -1,7 +1,7 @@
 """``autograder quiz``: list, lint, render, export, take, score, key and serve quizzes.
 
 A thin click layer: each command calls plain functions of the quiz package, and every
-bad input becomes one line naming the file (see ``autograder.commands.exits``).
+bad input becomes one line naming the file (see ``autograder.cli.exits``).
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from typing import Any, TypeVar
 
 import click
 
-from autograder.commands.exits import UsageProblem, report_problems
+from autograder.cli.exits import UsageProblem, report_problems
 from autograder.commands.written import say_written
 from autograder.core.errors import ContentError
 from autograder.core.results import RunResult
@@ -26,17 +26,11 @@ from autograder.i18n import (
     locales_dir,
     set_language,
 )
+from autograder.i18n.text import Text, format_number, format_percent, terminal
 from autograder.i18n.tools import read_catalog
 from autograder.quiz import CONTENT_DOMAIN
 from autograder.quiz.catalog import find_quiz, list_quizzes, load_each
-from autograder.quiz.localize import (
-    Localizer,
-    Text,
-    format_number,
-    format_percent,
-    require_translation,
-    terminal,
-)
+from autograder.quiz.localize import Localizer, require_translation
 from autograder.quiz.model import Quiz, QuizFile
 from autograder.quiz.render import render_markdown, render_page, render_result
 from autograder.quiz.scoring import (
@@ -237,7 +231,7 @@ def _summary(quiz: Quiz, result: RunResult) -> str:
         mark = "✔" if t.status == "passed" else "✘"
         lines.append(f" {mark} {format_number(n, lang)}. {_short(terminal(Text(t.label, lang)))} "
                      f"({format_number(t.score, lang)}/{format_number(t.max_score, lang)})")
-        answer = t.data.get("answer")
+        answer = t.answer
         said = t.message
         question = quiz.question(t.name)
         if answer is not None and question is not None:

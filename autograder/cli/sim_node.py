@@ -5,7 +5,7 @@ The node runs through the sandbox (:func:`autograder.sandbox.process.student_pro
 a throwaway copy, a minimal environment, ``--ros-args -p use_sim_time:=true``, resource
 limits, its own session, everything it started stopped with it) and simulation time is
 held until it is up on the graph, by the check grading uses
-(:mod:`autograder.sandbox.graph`). Its output streams to the terminal.
+(:mod:`autograder.plugin.graph`). Its output streams to the terminal.
 
 Two things differ from grading, on purpose: isolation is always basic (strict isolation
 puts the whole graph in a network namespace of its own, where ``sim drive`` and
@@ -16,7 +16,7 @@ puts the whole graph in a network namespace of its own, where ``sim drive`` and
 command its ``--node`` and ``--exercise`` options from here, and hands the node to the
 world as a :class:`sim.cli.Companion`.
 
-Exit codes as for every command (:mod:`autograder.commands.exits`), and 1 when the
+Exit codes as for every command (:mod:`autograder.cli.exits`), and 1 when the
 program did not get its node up.
 """
 
@@ -34,11 +34,11 @@ from typing import TYPE_CHECKING, Any
 import click
 from click.core import ParameterSource
 
+from autograder.cli.exits import GraderFault, UsageProblem
 from autograder.commands import stale
-from autograder.commands.exits import GraderFault, UsageProblem
 from autograder.commands.stale import hand_folder
 from autograder.core.errors import ContentError
-from autograder.core.output import describe_exit
+from autograder.core.output_budget import describe_exit
 from autograder.i18n import _
 from sim.cli import COMPANION
 
@@ -83,7 +83,7 @@ class NodeRun:
 
     def start(self, bridge: SimBridge) -> None:
         from autograder.core.submission import stage
-        from autograder.sandbox.graph import node_endpoints, wait_until_up
+        from autograder.plugin.graph import node_endpoints, wait_until_up
         from autograder.sandbox.process import LaunchFailed, student_process
 
         self._bridge = bridge

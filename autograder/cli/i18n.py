@@ -11,14 +11,14 @@ from pathlib import Path
 
 import click
 
-from autograder.commands.exits import UsageProblem, report_problems
-from autograder.core.course import course_root
+from autograder.cli.exits import UsageProblem, report_problems
 from autograder.core.errors import ContentError
-from autograder.i18n import LANGUAGES, _, locales_dir
-from autograder.i18n.glossary import check_language
-from autograder.i18n.tools import Problem, check_catalog, compile_catalogs, extract, update
+from autograder.i18n import _, locales_dir
+from autograder.i18n.glossary import TRANSLATIONS, check_all
+from autograder.i18n.tools import compile_catalogs, extract, update
+from content.course import course_root
 
-_TARGETS = tuple(lang for lang in LANGUAGES if lang != "en")
+_TARGETS = TRANSLATIONS
 
 
 def _relative(path: Path) -> str:
@@ -74,17 +74,3 @@ def check_command(langs: tuple[str, ...]) -> None:
     (file:line: message)."""
     report_problems(check_all(locales_dir(), langs, course_root()))
     click.echo(_("All catalogs are complete."))
-
-
-def check_all(locales: Path, langs: tuple[str, ...] = _TARGETS,
-              root: Path | None = None) -> list[Problem]:
-    """What ``i18n check`` finds: each template's entries translated in each language, and
-    the language rules (glossary, grammar, READMEs) of :func:`check_language`."""
-    problems: list[Problem] = []
-    for template in sorted(locales.glob("*.pot")):
-        for lang in langs:
-            po = locales / lang / "LC_MESSAGES" / f"{template.stem}.po"
-            problems += check_catalog(template, po, lang)
-    for lang in langs:
-        problems += check_language(locales, lang, root)
-    return problems

@@ -4,10 +4,8 @@ A malformed file is a :class:`ContentError` that names the file, the line and th
 so an instructor can go straight to the mistake.  Dataclasses describe each kind of file;
 every field has a default and a ``doc`` in its metadata.
 
-This is the one content layer of the project.  It lives in ``sim`` because world files
-need it and ``sim`` is the lowest layer (it imports nothing of ``autograder``); the
-autograder's exercise and quiz files use it from here, and ``autograder.core.errors``
-re-exports :class:`ContentError` for the rest of the autograder.
+This is the one content layer of the project: world, exercise and quiz files all read
+through it.
 """
 
 from __future__ import annotations
@@ -21,7 +19,7 @@ from typing import Any, TypeVar
 
 import yaml
 
-from sim.i18n import _
+from content.i18n import _
 
 T = TypeVar("T")
 

@@ -44,10 +44,10 @@ def run_program(script: str, args: list[str]) -> None:
     try:
         with open(script, "rb") as source:
             code = compile(source.read(), script, "exec")
-        exec(code, main.__dict__)  # noqa: S102 - running the student's program is the point
+        exec(code, main.__dict__)  # running the student's program is the point
     except SystemExit:
         raise
-    except BaseException as exc:  # noqa: BLE001 - reported as the interpreter would
+    except BaseException as exc:  # reported as the interpreter would
         tb = exc.__traceback__.tb_next if exc.__traceback__ is not None else None
         sys.excepthook(type(exc), exc.with_traceback(tb), tb)
         if not isinstance(exc, KeyboardInterrupt):

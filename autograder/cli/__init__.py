@@ -1,7 +1,8 @@
-"""The ``autograder`` command: a thin click layer over plain functions.
+"""The ``autograder`` command: a thin click layer over plain functions (``commands/``).
 
-Exit codes: 0 when grading completed, whatever the score; 2 for usage errors (a missing
-file, an unknown exercise, a malformed content file); 3 when the autograder itself failed.
+Exit codes: 0 when the command completed (a grading, whatever the score); 1 when a check
+found problems; 2 for bad input (a missing file, an unknown exercise, a malformed content
+file); 3 when the autograder itself failed (:mod:`autograder.cli.exits`).
 """
 
 from __future__ import annotations
@@ -9,24 +10,28 @@ from __future__ import annotations
 import json
 import shutil
 import signal
-import sys
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import click
 
 from autograder import __version__
-from autograder.commands.exits import GraderFault, UsageProblem, report_problems
+from autograder.cli.exits import GraderFault, UsageProblem, report_problems
 from autograder.core.dumpable import not_dumpable
-from autograder.core.errors import ContentError
+from autograder.core.errors import ContentError, GraderError, UsageError
 from autograder.core.pid1 import reap_as_init
-from autograder.i18n import LANGUAGES, _, get_language, ngettext, set_language
+from autograder.i18n import LANGUAGES, _, ngettext, set_language
+
+if TYPE_CHECKING:
+    from autograder.core.exercise import Exercise
+
+F = TypeVar("F", bound=Callable[..., Any])
 
 
 def _sim_cli() -> click.Command:
+    from autograder.cli.sim_node import add_node_options
     from autograder.commands.ending import until_stopped
-    from autograder.commands.sim_node import add_node_options
     from sim.cli import sim_cli
 
     add_node_options(sim_cli.commands["run"])  # sim knows nothing of students' nodes
@@ -37,15 +42,15 @@ def _sim_cli() -> click.Command:
 
 
 def _quiz_cli() -> click.Command:
+    from autograder.cli.quiz import quiz_cli
     from autograder.commands.ending import until_stopped
-    from autograder.quiz.cli import quiz_cli
 
     until_stopped(quiz_cli.commands["serve"], lambda options: True)
     return quiz_cli
 
 
 def _i18n_cli() -> click.Command:
-    from autograder.i18n.cli import i18n_cli
+    from autograder.cli.i18n import i18n_cli
 
     return i18n_cli
 
@@ -81,12 +86,17 @@ class LazyGroup(click.Group):
                 raise SystemExit(state.exit_status(exc.code)) from None
 
     def invoke(self, ctx: click.Context) -> Any:
+        """The exit status of each exception family (:mod:`autograder.cli.exits`)."""
         from autograder.commands.ending import Stopped
 
         try:
             return super().invoke(ctx)
         except Stopped:  # not Ctrl-C: the status says which signal, not "Aborted!"
             ctx.exit(1)
+        except (UsageError, ContentError) as exc:
+            raise UsageProblem(str(exc)) from None
+        except GraderError as exc:
+            raise GraderFault(str(exc)) from None
 
 
 @click.group(cls=LazyGroup)
@@ -101,16 +111,13 @@ def main(lang: str | None) -> None:
         set_language(lang)
 
 
-def _exercise(name: str):  # noqa: ANN202 - returns autograder.core.exercise.Exercise
-    from autograder.core.exercise import find_exercise
+def _exercise(name: str) -> Exercise:
+    from autograder.commands.grade import exercise
 
-    try:
-        return find_exercise(name)
-    except ContentError as exc:
-        raise UsageProblem(str(exc)) from None
+    return exercise(name)
 
 
-def _lang_option(func):  # noqa: ANN001, ANN202
+def _lang_option(func: F) -> F:
     """``--lang`` on a subcommand too (``autograder grade ... --lang ur``)."""
 
     def set_lang(ctx: click.Context, param: click.Parameter, value: str | None) -> None:
@@ -126,7 +133,7 @@ VERBOSE = "autograder.verbose"
 """``ctx.meta`` key: ``--verbose`` was given (see :func:`_verbose_option`)."""
 
 
-def _verbose_option(func):  # noqa: ANN001, ANN202
+def _verbose_option(func: F) -> F:
     """``--verbose``: the instructor's technical lines (how the program was contained and
     bounded) instead of the student's sentence."""
 
@@ -204,115 +211,7 @@ def start(exercise: str, directory: Path | None) -> None:
         file=target / found.file, exercise=found.id))
 
 
-def refuse_unofficial(option: str) -> None:
-    """End with a grader fault, naming why, where this machine cannot give an official
-    grade (the student's program would run as the grader's user): recipes that produce
-    grades for a gradebook never hand out a grade a program could have changed."""
-    from autograder.sandbox.isolation import detect
-
-    isolation = detect()
-    if not isolation.official:
-        raise GraderFault(_(
-            "This machine cannot give official grades ({reason}): a student's program would "
-            "run as the grader's user and could change its result. Grade as root (see "
-            "docs/operators/security.md), or pass {option} to grade anyway, unofficially.").format(
-            reason=_(isolation.reason), option=option))
-
-
-def _run(exercise: str, submission: Path, hidden: bool, outputs: dict[str, Path | None],
-         rtf: float | None, domain: int | None, record: Path | None = None,
-         module_jobs: int | str = "auto", require_official: bool = False) -> None:
-    from autograder.commands.ending import Stopped
-    from autograder.commands.written import say_written
-    from autograder.core.report import RawTest
-    from autograder.core.submission import SubmissionNotFound, check
-    from autograder.grading.run import grade, result_of
-    from autograder.render.live import LiveLines, terminal_style
-    from autograder.render.terminal import for_terminal, heading, rtl_notice, to_terminal
-
-    found = _exercise(exercise)
-    try:  # a link, a FIFO, not a node Python runs: the student's error, said first
-        check(submission, found.file)
-    except SubmissionNotFound as exc:
-        raise UsageProblem(str(exc)) from None
-    if require_official:
-        refuse_unofficial("--no-require-official")
-    color, in_place = terminal_style(sys.stdout)
-    # Every test line once, on stdout as the tests end; the summary after them adds the
-    # failures and the score (and the lines of tests that never ended).
-    live = LiveLines(lambda text: click.echo(text, nl=False), color, in_place)
-
-    def running(now: list[RawTest]) -> None:
-        live.running_now([(raw.nodeid, raw.label) for raw in now])
-
-    notice = rtl_notice(html=outputs.get("html"))
-    if notice:
-        click.echo(notice, err=True)
-    click.echo(for_terminal(_("Grading {file} for {exercise} in the simulator...").format(
-        file=submission, exercise=found.id)), err=True)
-    click.echo(heading(found.id, found.localized_title, color) + "\n")
-    try:
-        result = grade(found, submission, hidden=hidden, domain=domain, real_time_factor=rtf,
-                       progress=lambda raw: live.done(result_of(raw)), running=running,
-                       record=record, module_jobs=module_jobs)
-    except Stopped as exc:  # what the grading started is stopped and removed by now
-        live.close()
-        click.echo(for_terminal(_("The grading was stopped ({signal}) before it finished: "
-                                  "no score, and no file written.").format(signal=exc.name)),
-                   err=True)
-        raise
-    finally:
-        live.close()
-    # The files first: whatever happens to stdout (a pipe closed early), they are written.
-    written = write_outputs(result, outputs, found.folder)
-    click.echo(to_terminal(result, color=color, shown=live.shown, with_heading=False,
-                           verbose=click.get_current_context().meta.get(VERBOSE, False)))
-    _say_recorded(result, record)
-    say_written(written)
-    if result.grader_error:
-        raise GraderFault(result.grader_error)
-
-
-def _say_recorded(result, record: Path | None) -> None:  # noqa: ANN001 - a RunResult
-    """Where ``--record`` put the bags, and any warning about them (on stderr)."""
-    from autograder.i18n import ngettext
-    from autograder.render.terminal import for_terminal
-
-    bags = result.data.get("bags", {})
-    if record is not None and bags:
-        click.echo(for_terminal(ngettext(
-            "{count} recording (rosbag2, MCAP) written to {path}",
-            "{count} recordings (rosbag2, MCAP) written to {path}", len(bags)).format(
-            count=len(bags), path=record)), err=True)
-    for warning in result.data.get("warnings", []):
-        click.echo(for_terminal(_("Warning: {message}").format(message=warning)), err=True)
-
-
-def write_outputs(result, outputs: dict[str, Path | None],  # noqa: ANN001
-                  folder: Path) -> list[tuple[str, Path]]:
-    """Write each requested output format of ``result`` (``--results``, ``--html``, ...:
-    see :mod:`autograder.render`); with ``--results FILE``, the programs' whole output goes
-    to FILE with suffix ``.log`` (``log`` names another file for it). Each (format, path)
-    written, in order."""
-    from autograder.core.files import write_atomically
-    from autograder.core.output import log_beside
-    from autograder.render import formats
-
-    outputs = dict(outputs)
-    if outputs.get("results") is not None and result.kind == "exercise":
-        outputs.setdefault("log", log_beside(outputs["results"]))
-    written = []
-    for name, path in outputs.items():
-        if path is None:
-            continue
-        path.parent.mkdir(parents=True, exist_ok=True)
-        text = result.log if name == "log" else formats()[name].render(result, folder)
-        write_atomically(path, text)
-        written.append((name, path))
-    return written
-
-
-def _formats(func):  # noqa: ANN001, ANN202
+def _formats(func: F) -> F:
     """A ``--NAME FILE`` option per output format (autograder.render)."""
     from autograder.render import formats
 
@@ -338,7 +237,8 @@ class _CountOrAuto(click.ParamType):
     def __init__(self, error: Callable[[], str]) -> None:
         self._error = error
 
-    def convert(self, value, param, ctx):  # noqa: ANN001, ANN201
+    def convert(self, value: Any, param: click.Parameter | None,
+                ctx: click.Context | None) -> int | str:
         if isinstance(value, int) or value == "auto":
             return value
         try:
@@ -378,7 +278,10 @@ _record = click.option("--record", type=click.Path(path_type=Path, file_okay=Fal
 def check(exercise: str, submission: Path, rtf: float | None, domain: int | None,
           module_jobs: int | str, record: Path | None, **outputs: Path | None) -> None:
     """Run the public tests of EXERCISE on SUBMISSION (for students)."""
-    _run(exercise, submission, False, outputs, rtf, domain, record, module_jobs)
+    from autograder.commands.grade import check_or_grade
+
+    check_or_grade(exercise, submission, False, outputs, rtf, domain, record, module_jobs,
+                   verbose=click.get_current_context().meta.get(VERBOSE, False))
 
 
 @main.command("grade")
@@ -400,8 +303,10 @@ def grade_command(exercise: str, submission: Path, rtf: float | None, domain: in
                   **outputs: Path | None) -> None:
     """Run the public and hidden tests of EXERCISE on SUBMISSION (the student's .py file or a
     folder holding it)."""
-    _run(exercise, submission, True, outputs, rtf, domain, record, module_jobs,
-         require_official)
+    from autograder.commands.grade import check_or_grade
+
+    check_or_grade(exercise, submission, True, outputs, rtf, domain, record, module_jobs,
+                   require_official, verbose=click.get_current_context().meta.get(VERBOSE, False))
 
 
 @main.command()
@@ -472,109 +377,9 @@ def grade_batch(item: str, submissions: Path, jobs: int | str, csv_path: Path, o
     """Grade every submission in SUBMISSIONS (one sub-folder or file per student), or score
     every answers file for a quiz. Resumable: graded students are skipped. Exercises are
     graded only where the grades are official, unless --allow-unofficial."""
-    from autograder.commands.batch import parse_shard, run_batch, students
-    from autograder.core.results import number
+    from autograder.commands.grade import grade_batch as run
 
-    if _exercise_or_none(item) is not None:
-        if not allow_unofficial:
-            refuse_unofficial("--allow-unofficial")
-        _close_class(submissions, out or Path("grades") / item)
-
-    try:
-        share = parse_shard(shard) if shard else None
-    except ValueError:
-        raise UsageProblem(_("--shard must be I/N with `1 <= I <= N`, got {value}").format(
-            value=shard)) from None
-    out = out or Path("grades") / item
-    if jobs == "auto" and _exercise_or_none(item) is None:
-        jobs = 1  # a quiz scores in milliseconds, in this process: nothing to share
-    if module_jobs is None:  # several gradings at once already keep the cores busy
-        module_jobs = "auto" if jobs == 1 else 1
-    grade_one, suffix, extra = _batch_item(item, record, module_jobs)
-
-    def progress(student: str, result) -> None:  # noqa: ANN001
-        if result is None:
-            click.echo(_("{student}: already graded").format(student=student), err=True)
-        else:
-            # Decimals, as the gradebook has them (20/3 points is 6.6667, not "20/3").
-            click.echo(f"{student}: {number(result.score)}/{number(result.max_score)}",
-                       err=True)
-
-    if jobs == "auto":
-        from autograder.grading.capacity import auto_chooser
-
-        jobs = auto_chooser(lambda line: click.echo(line, err=True))
-    rows = run_batch(students(submissions, suffix), grade_one, out, csv_path, jobs=jobs,
-                     shard=share, extra=extra, progress=progress)
-    click.echo(ngettext("{count} row in {path}", "{count} rows in {path}", len(rows)).format(
-        count=len(rows), path=csv_path))
-
-
-def _close_class(submissions: Path, out: Path) -> None:
-    """Isolation by user: no namespace hides the other students' submissions and reports
-    from a student's program, so their folders are closed to other users."""
-    from autograder.sandbox.isolation import close_to_others, detect
-
-    if detect().mode == "user":
-        out.mkdir(parents=True, exist_ok=True)
-        close_to_others([submissions, out])
-
-
-def _exercise_or_none(item: str):  # noqa: ANN202 - an Exercise, or None
-    """The exercise ``item`` names, or None (a quiz, or nothing)."""
-    try:
-        return _exercise(item)
-    except UsageProblem:
-        return None
-
-
-def _batch_item(item: str, record: Path | None = None,  # noqa: ANN202
-                module_jobs: int | str = "auto"):
-    """How to grade one student's entry for an exercise or a quiz (``record``: a folder
-    for each student's bags, exercises only; ``module_jobs``: see :func:`grade`)."""
-    from autograder.core.names import UnknownName, unknown_item
-    from autograder.grading.run import grade
-    from autograder.quiz.catalog import find_quiz
-    from autograder.quiz.scoring import read_answers, score
-    from autograder.render import formats
-
-    exercise = _exercise_or_none(item)
-    if exercise is not None:
-        def extra(result, folder: Path) -> None:  # noqa: ANN001
-            # Every format with a file per student; results.json is the batch's own
-            # (written last: it marks the student done).
-            files = {f.name: folder / f.batch_file for f in formats().values()
-                     if f.batch_file and f.name != "results"}
-            write_outputs(result, {**files, "log": folder / "output.log"}, exercise.folder)
-
-        def grade_one(path: Path):  # noqa: ANN202 - a RunResult
-            # The student's name as `students()` gives it: a folder's name, a file's stem.
-            student = path.name if path.is_dir() else path.stem
-            return grade(exercise, path, record=record / student if record else None,
-                         module_jobs=module_jobs)  # type: ignore[arg-type]
-
-        return grade_one, None, extra
-    if record is not None:
-        raise UsageProblem(_("--record records exercise gradings, not quizzes"))
-    try:
-        quiz = find_quiz(item).quiz
-    except UnknownName as exc:  # neither: the one meant among both kinds
-        from autograder.core.exercise import list_exercises
-        from autograder.quiz.catalog import load_all
-
-        raise UsageProblem(str(unknown_item(
-            item, [e.id for e in list_exercises()], [q.quiz.id for q in load_all()],
-            exc.path))) from None
-    except ContentError as exc:
-        raise UsageProblem(str(exc)) from None
-
-    def score_one(path: Path):  # noqa: ANN202
-        try:
-            return score(quiz, read_answers(path, quiz), get_language())
-        except ContentError:
-            return score(quiz, {}, get_language())  # an unreadable answers file scores 0
-
-    return score_one, ".json", None
+    run(item, submissions, jobs, csv_path, out, shard, record, module_jobs, allow_unofficial)
 
 
 @main.group("gradebook")

@@ -2,13 +2,13 @@
 each program from there, so a launch skips Python's start and the imports (about 0.3
 CPU-seconds of the 0.45 an rclpy program spends before its node exists).
 
-    python -s -m autograder.sandbox.zygote FD
+    python -s -m autograder.sandbox.contained.zygote FD
 
 FD is one end of a ``SOCK_SEQPACKET`` socket pair; the grader (:class:`Zygote`) holds the
 other.  The zygote imports what students' nodes import, says ``ready``, and then for each
-request forks a child that does what :mod:`autograder.sandbox.launcher` does before its
+request forks a child that does what :mod:`.launcher` does before its
 ``exec`` (its own session, the environment and working folder asked for, output on the
-pipe handed over, then :func:`~autograder.sandbox.launcher.contain`: cgroups, limits, and in
+pipe handed over, then :func:`~.launcher.contain`: cgroups, limits, and in
 strict isolation the mount namespace and the student's user) and then runs the program as
 ``python SCRIPT ARGS...`` would, as the interpreter's main program.  The zygote tells the
 grader each child's pid, and its wait status and peak resident size once it has exited.
@@ -35,8 +35,8 @@ import sys
 import threading
 from collections.abc import Callable, Mapping, Sequence
 
-from autograder.sandbox.launcher import LAUNCH_FAILED, contain
-from autograder.sandbox.runner import run_program
+from autograder.sandbox.contained.launcher import LAUNCH_FAILED, contain
+from autograder.sandbox.contained.runner import run_program
 
 # What students' nodes import (the chapter's exercises and the book's code): imported once
 # here instead of in every program.  A missing one is skipped.
@@ -178,7 +178,7 @@ def _become_program(request: dict, fds: list[int]) -> tuple[str, list[str]]:
         os.environ.update(request["env"])
         os.chdir(request["cwd"])
         contain(request["spec"], stage)
-    except BaseException as exc:  # noqa: BLE001 - every failure before the program is ours
+    except BaseException as exc:  # every failure before the program is ours
         os.write(status, json.dumps({"stage": stage[0],
                                      "error": f"{type(exc).__name__}: {exc}"}).encode())
         os._exit(LAUNCH_FAILED)
@@ -229,7 +229,7 @@ class Zygote:
         ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
         try:
             self.process = subprocess.Popen(
-                [python, "-s", "-m", "autograder.sandbox.zygote", str(theirs.fileno())],
+                [python, "-s", "-m", "autograder.sandbox.contained.zygote", str(theirs.fileno())],
                 env={**env, "OPENBLAS_NUM_THREADS": "1"}, cwd=cwd, stdin=subprocess.DEVNULL,
                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True,
                 pass_fds=(theirs.fileno(),))

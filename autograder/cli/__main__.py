@@ -1,0 +1,5 @@
+"""``python -m autograder.cli``: the ``autograder`` command."""
+
+from autograder.cli import main
+
+main()

@@ -1,0 +1,85 @@
+"""Isolation's start-up check, a process of its own in the run's namespaces::
+
+    python -I -m autograder.sandbox.startup_check MODE
+
+starts a test program exactly as a student's is started in isolation ``MODE``
+(:func:`autograder.sandbox.process.student_process`) and exits 0 if it ran Python and
+rclpy as a user of its own, else prints what went wrong and exits 1
+(:func:`autograder.sandbox.isolation.detect` reads it).
+"""
+
+from __future__ import annotations
+
+import shutil
+import sys
+from pathlib import Path
+
+from autograder.sandbox.isolation import Mode, bring_up_loopback, student_uid
+from autograder.sandbox.privileged import PACKAGE_PARENT
+
+# What the start-up check's test program runs: Python, rclpy and its middleware.
+PROBE_PROGRAM = """\
+import os
+import rclpy
+
+rclpy.init()
+rclpy.shutdown()
+print("autograder-probe-ok", os.getuid())
+"""
+
+
+def probe_launch(mode: Mode = "strict") -> str | None:
+    """Start a test program exactly as a student's is started in isolation ``mode``; None
+    if it ran as its own user, else what went wrong. Runs inside the run's namespaces."""
+    import tempfile
+
+    from autograder.core.exercise import Limits
+    from autograder.sandbox.process import LaunchFailed, student_process
+
+    if mode == "strict":
+        bring_up_loopback()
+    with tempfile.TemporaryDirectory(prefix="autograder-probe-",
+                                     ignore_cleanup_errors=True) as tmp:
+        script = Path(tmp) / "staged" / "probe.py"
+        script.parent.mkdir()
+        script.write_text(PROBE_PROGRAM)
+        process = student_process(script, [], Limits(), domain=0, mode=mode,
+                                  course=Path(PACKAGE_PARENT))
+        try:
+            try:
+                process.start()
+            except LaunchFailed as exc:
+                return str(exc)
+            status = process.wait(60.0)
+        finally:  # also when stopped (see __main__): nothing of the test program is left
+            if process.popen is not None:
+                process.stop(grace=1.0)
+            shutil.rmtree(process.workdir, ignore_errors=True)
+        expected = f"autograder-probe-ok {student_uid(0)}"
+        if status == 0 and expected in process.output_text():
+            return None
+        return (f"the test program exited with status {status}: "
+                f"{process.output_tail(3) or '(no output)'}")
+
+
+
+def _stop_as_ctrl_c() -> None:
+    """SIGTERM, SIGHUP, and the grader's death (``PR_SET_PDEATHSIG``) end the probe as
+    Ctrl-C would: its ``finally`` stops the test program and removes its folders."""
+    import ctypes
+    import signal
+
+    def stop(signum: int, frame: object) -> None:
+        raise KeyboardInterrupt
+
+    for sig in (signal.SIGTERM, signal.SIGHUP):
+        signal.signal(sig, stop)
+    ctypes.CDLL(None).prctl(1, signal.SIGTERM, 0, 0, 0)  # PR_SET_PDEATHSIG
+
+
+if __name__ == "__main__":
+    _stop_as_ctrl_c()
+    problem = probe_launch(*sys.argv[1:2])  # type: ignore[arg-type]
+    if problem is not None:
+        print(problem)
+        sys.exit(1)
