@@ -4,6 +4,7 @@ as each grading ends."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import threading
 from fractions import Fraction
@@ -138,11 +139,11 @@ def test_a_starved_student_caps_the_concurrency_below_where_it_happened() -> Non
 
 
 @pytest.mark.parametrize(("pacing", "expected"), [
-    (None, False), ({}, False), ({"test_a": {"idle": 40, "budget": 2, "cap": 0}}, False),
+    ({}, False), ({"test_a": {"idle": 40, "budget": 2, "cap": 0}}, False),
     ({"test_a": {"idle": 40}, "test_b": {"idle": 9, "cap": 1}}, True)],
-    ids=["no-world", "no-modules", "held-within-budget", "cap-hit"])
+    ids=["no-world", "held-within-budget", "cap-hit"])
 def test_starved_reads_the_pacing_cap(pacing, expected) -> None:
-    assert starved({"pacing": pacing} if pacing is not None else {}) is expected
+    assert starved(dataclasses.replace(_result(3), pacing=pacing)) is expected
 
 
 def test_the_chooser_decides_again_and_says_so_only_when_the_number_changes() -> None:
@@ -150,10 +151,11 @@ def test_the_chooser_decides_again_and_says_so_only_when_the_number_changes() ->
     said: list[str] = []
     chooser = AutoChooser(said.append, cores=lambda: 2.0, memory_mb=lambda: 8000.0,
                           cpu=lambda: next(cpu))
-    assert chooser(10.0, {}, 1, 10) == 5  # 0.8 of a core: 2 cores x 2.0 / 0.8
-    assert chooser(20.0, {}, 5, 9) == 8  # a mean of 4.25 s over the first 10 s: 0.425
-    assert chooser(25.0, {}, 8, 8) == 8  # 0.4: still the ceiling, nothing said
-    assert chooser(25.0, {"pacing": {"m": {"cap": 2}}}, 7, 7) == 6  # starved at 7
+    plain, starving = _result(3), dataclasses.replace(_result(3), pacing={"m": {"cap": 2}})
+    assert chooser(10.0, plain, 1, 10) == 5  # 0.8 of a core: 2 cores x 2.0 / 0.8
+    assert chooser(20.0, plain, 5, 9) == 8  # a mean of 4.25 s over the first 10 s: 0.425
+    assert chooser(25.0, plain, 8, 8) == 8  # 0.4: still the ceiling, nothing said
+    assert chooser(25.0, starving, 7, 7) == 6  # starved at 7
     assert [line.split(".")[0] for line in said] == [
         "--jobs auto: 5 gradings at a time", "--jobs auto: 8 gradings at a time",
         "--jobs auto: 6 gradings at a time"]
@@ -177,7 +179,7 @@ def test_auto_grades_the_first_alone_then_chooses_as_each_ends(tmp_path) -> None
             running[0] -= 1
         return _result(3)
 
-    def chooser(wall: float, data: dict, at_once: int, left: int) -> int:
+    def chooser(wall: float, result: RunResult, at_once: int, left: int) -> int:
         asked.append((at_once, left, len(list((tmp_path / "out").iterdir()))))
         return 1 if left > 2 else 3
 
@@ -192,7 +194,7 @@ def test_auto_grades_the_first_alone_then_chooses_as_each_ends(tmp_path) -> None
 
 
 def test_auto_with_one_student_left_chooses_nothing(tmp_path) -> None:
-    def chooser(wall: float, data: dict, at_once: int, left: int) -> int:
+    def chooser(wall: float, result: RunResult, at_once: int, left: int) -> int:
         raise AssertionError("not asked")
 
     rows = run_batch({"only": tmp_path / "only"}, lambda p: _result(2), tmp_path / "out",

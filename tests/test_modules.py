@@ -235,7 +235,7 @@ def test_grade_batch_runs_modules_at_once_only_when_it_grades_one_at_a_time(
 
     monkeypatch.setattr(run, "grade", fake_grade)
     monkeypatch.setattr("autograder.grading.capacity.auto_chooser",
-                        lambda report=None: lambda wall, data, at_once, left: 2)
+                        lambda report=None: lambda wall, result, at_once, left: 2)
     (tmp_path / "subs").mkdir()
     for student in ("alice", "bob"):
         (tmp_path / "subs" / f"{student}.py").write_text("")

@@ -20,17 +20,16 @@ from collections import deque
 from collections.abc import Callable
 from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
 from pathlib import Path
-from typing import Any
 
 from autograder.commands import gradebook
 from autograder.core.files import write_atomically
 from autograder.core.results import RunResult
 from autograder.grading.capacity import MAX_JOBS
 
-# Told of each grading as it ends (its wall seconds, its results' data, how many ran at
-# once then, itself included, and how many students are left, running or not), the
+# Told of each grading as it ends (its wall seconds, its results, how many ran at once
+# then, itself included, and how many students are left, running or not), the
 # concurrency for the rest.
-Chooser = Callable[[float, dict[str, Any], int, int], int]
+Chooser = Callable[[float, RunResult, int, int], int]
 
 
 def students(folder: Path, suffix: str | None = None) -> dict[str, Path]:
@@ -120,7 +119,7 @@ def run_batch(entries: dict[str, Path], grade_one: Callable[[Path], RunResult], 
             for future in done:
                 result, wall = future.result()
                 if chooser is not None and queue:
-                    limit = max(1, min(workers, chooser(wall, result.data, at_once,
+                    limit = max(1, min(workers, chooser(wall, result, at_once,
                                                         len(queue) + len(running))))
     return _write_gradebook(out, mine, csv_path)
 

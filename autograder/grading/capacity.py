@@ -18,8 +18,9 @@ import threading
 import time
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any, Literal, TypeVar
+from typing import Literal, TypeVar
 
+from autograder.core.results import RunResult
 from autograder.i18n import _, ngettext
 
 # Cores the gradings may ask for together, as a multiple of the cores there are. Above 1:
@@ -236,10 +237,10 @@ def decide(tally: Tally, *, cores: float, memory_mb: float, students: int,
                        strained=strained)
 
 
-def starved(data: dict[str, Any]) -> bool:
-    """Whether a grading's results (``data``) show a student's program starved of CPU: a
-    world that went on at its wall cap while the program still had work (``pacing``)."""
-    return any(module.get("cap", 0) for module in (data.get("pacing") or {}).values())
+def starved(result: RunResult) -> bool:
+    """Whether a grading's results show a student's program starved of CPU: a world that
+    went on at its wall cap while the program still had work (``pacing``)."""
+    return any(module.get("cap", 0) for module in result.pacing.values())
 
 
 class AutoChooser:
@@ -259,15 +260,15 @@ class AutoChooser:
         self.tally = Tally()
         self.jobs: int | None = None
 
-    def __call__(self, wall: float, data: dict[str, Any], at_once: int, students: int) -> int:
-        """One grading ended after ``wall`` seconds with results ``data``, ``at_once``
+    def __call__(self, wall: float, result: RunResult, at_once: int, students: int) -> int:
+        """One grading ended after ``wall`` seconds with ``result``, ``at_once``
         running then (itself included), ``students`` left to grade (running or not)."""
         with self._lock:
             now = self._cpu()
-            memory = data.get("memory") or {}
+            memory = result.memory
             self.tally = self.tally.add(wall=wall, cpu_seconds=now - self._last_cpu,
                                         footprint_mb=memory.get("footprint_mb"),
-                                        strained=starved(data), at_once=at_once)
+                                        strained=starved(result), at_once=at_once)
             self._last_cpu = now
             choice = decide(self.tally, cores=self._cores(), memory_mb=self._memory_mb(),
                             students=max(1, students))
