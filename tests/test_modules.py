@@ -263,3 +263,11 @@ def test_a_childs_report_is_parsed_again_only_when_it_changed(
     assert len(parsed) == 2
     report.write(path, [_test(PUBLIC, "test_one")], {}, b"x" * 32)  # not ours: forged
     assert child.reported_tests() == []
+
+
+def test_each_childs_sim_seconds_are_joined_for_the_floor() -> None:
+    first = RawReport(tests=[], data={"sim_seconds": {"tests/public/test_a.py::t1": 2.5}})
+    second = RawReport(tests=[], data={"sim_seconds": {"tests/hidden/test_b.py::t2": 4.0}})
+    merged = merge([first, second], ["tests/public/test_a.py", "tests/hidden/test_b.py"])
+    assert merged.data["sim_seconds"] == {"tests/public/test_a.py::t1": 2.5,
+                                          "tests/hidden/test_b.py::t2": 4.0}

@@ -272,13 +272,15 @@ def _timing(data: dict[str, Any], launched: float, elapsed: float) -> dict[str, 
     the first test: pytest, the plugin, collecting the tests), the tests (per module, see
     :mod:`autograder.plugin.timing`; summed, so more than ``total`` when modules run at
     once) and the total, from the grader's call. ``launched`` is when the first child was
-    started (the monotonic clock, the same in every process)."""
+    started (the monotonic clock, the same in every process). ``sim_seconds``: each
+    test's simulation seconds to its verdict, by node id (see the reporter)."""
     modules = data.get("timing", {})
     first = data.get("first_test_at")
     child_start = None if first is None else round(max(0.0, first - launched), 3)
     return {"child_start": child_start,
             "tests": round(sum(m.get("total", 0.0) for m in modules.values()), 3),
-            "total": round(elapsed, 3), "modules": modules}
+            "total": round(elapsed, 3), "modules": modules,
+            "sim_seconds": data.get("sim_seconds", {})}
 
 
 def _fault(exercise: Exercise, details: str, elapsed: float) -> RunResult:
