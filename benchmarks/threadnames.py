@@ -23,12 +23,23 @@ def name_this_thread(name: str) -> None:
     _libc.prctl(_PR_SET_NAME, name.encode()[:15], 0, 0, 0)
 
 
+_folder = os.environ.get("AUTOGRADER_BENCH_PROFILE")
+_PROFILED = ("sim-physics", "sim-executor", "probe-executor")
 _bootstrap = threading.Thread._bootstrap_inner  # type: ignore[attr-defined]
 
 
 def _named_bootstrap(self: Any) -> None:
     name_this_thread(self.name)
-    _bootstrap(self)
+    if not (_folder and self.name in _PROFILED):
+        _bootstrap(self)
+        return
+    profile = cProfile.Profile()
+    profile.enable()
+    try:
+        _bootstrap(self)
+    finally:
+        profile.disable()
+        profile.dump_stats(os.path.join(_folder, f"{self.name}-{threading.get_native_id()}.prof"))
 
 
 threading.Thread._bootstrap_inner = _named_bootstrap  # type: ignore[attr-defined]
@@ -36,8 +47,8 @@ name_this_thread("pytest-main")
 
 
 # With AUTOGRADER_BENCH_PROFILE=FOLDER, the main thread is also profiled (cProfile) from
-# here to the end of the session, into FOLDER/pytest-PID.prof.
-_folder = os.environ.get("AUTOGRADER_BENCH_PROFILE")
+# here to the end of the session, into FOLDER/pytest-PID.prof, and each thread named in
+# _PROFILED into FOLDER/NAME-TID.prof.
 _profile = cProfile.Profile() if _folder else None
 if _profile is not None:
     _profile.enable()
