@@ -214,10 +214,12 @@ def _run(exercise: Exercise, submission: Path | None, plan: _Plan,
          ) -> tuple[RunResult, RawReport]:
     """One grading in child pytests, one per reserved domain; the result and the merged
     raw report. Each child gets its :class:`~autograder.core.settings.RunSettings` as one
-    document (see :mod:`autograder.grading.children`). A single child forks students'
-    programs from a zygote (it runs every module's, and a batch's CPU is what it saves);
-    children at once exec them (a zygote each would add about 20 MB each to the grading's
-    memory, for a start or two a child)."""
+    document (see :mod:`autograder.grading.children`). Every child forks students'
+    programs from a zygote of its own (in its own namespaces): a zygote costs about what
+    one exec'd start does and each later start is a fork, so a node is on the graph in
+    about 0.3 s instead of 1 to 1.5 on a busy 2-core machine, and error_handling's eight
+    starts cost 1.8 CPU-seconds less, for 25 to 40 MB more footprint
+    (benchmarks/RESULTS.md)."""
     targets = plan.targets(len(locks))
     settings = RunSettings(
         domains=tuple(lock.domain for lock in locks),
@@ -239,7 +241,7 @@ def _run(exercise: Exercise, submission: Path | None, plan: _Plan,
                         run_prefix(isolation),
                         dataclasses.replace(settings, count_only=count_only),
                         [str(t) for t in group], Path(tmp) / f"child-{index}",
-                        exercise.folder, lock, zygote=len(targets) == 1)))
+                        exercise.folder, lock)))
                 footprint = Footprint([child.process.pid for child in running])
                 children.wait(running, exercise.time_limit, watchers, footprint)
         except BaseException:  # stopped (a signal, Ctrl-C): the children go before tmp
