@@ -218,7 +218,7 @@ def _run(exercise: Exercise, submission: Path | None, plan: _Plan,
     programs from a zygote of its own (in its own namespaces): a zygote costs about what
     one exec'd start does and each later start is a fork, so a node is on the graph in
     about 0.3 s instead of 1 to 1.5 on a busy 2-core machine, and error_handling's eight
-    starts cost 1.8 CPU-seconds less, for 25 to 40 MB more footprint
+    starts cost 1.8 CPU-seconds less, for 25 to 57 MB more footprint
     (benchmarks/RESULTS.md)."""
     targets = plan.targets(len(locks))
     settings = RunSettings(
