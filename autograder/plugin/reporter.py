@@ -29,7 +29,7 @@ from autograder.core.results import exact
 from autograder.i18n import _
 from autograder.plugin.markers import marker_problem
 from autograder.plugin.msgtypes import type_note
-from autograder.plugin.stash import credit_key, evidence_key, settings_key
+from autograder.plugin.stash import credit_key, evidence_key, settings_key, world_key
 from autograder.plugin.timing import Timing, module_of
 
 
@@ -90,6 +90,7 @@ class GradingReporter:
         self.hidden_default = "after_published"
         self.timing = Timing()
         self.spawn_gate = SpawnGate()
+        self._sim_began = 0.0
 
     def write(self) -> None:
         if self.path is not None:
@@ -186,17 +187,31 @@ class GradingReporter:
                 _update(entry, **_classify(call.excinfo))
         elif call.when == "teardown" and outcome_report.failed and entry.status == "passed":
             _update(entry, **_classify(call.excinfo))
+        if call.when == "call":
+            self._note_sim_seconds(item)
         if call.when == "teardown" and entry.status == "failed":
             _lead_with(entry, type_note(item))
         _bound(entry)
 
     @pytest.hookimpl(hookwrapper=True)
     def pytest_runtest_protocol(self, item: pytest.Item) -> Iterator[None]:
-        """Time each test whole (setup, call, teardown) into its module's total."""
+        """Time each test whole (setup, call, teardown) into its module's total; note the
+        world's simulation time when it starts (0 when its setup starts the world)."""
         began = time.monotonic()
         self.data.setdefault("first_test_at", began)
+        world = item.config.stash.get(world_key, None)
+        self._sim_began = world.now if world is not None else 0.0
         yield
         self.timing.add(module_of(item.nodeid), "total", time.monotonic() - began)
+
+    def _note_sim_seconds(self, item: pytest.Item) -> None:
+        """The simulation seconds a test took to its verdict (its setup and call; time
+        stands still while a node starts): ``sim_seconds`` by node id, for the benchmarks'
+        floor (``benchmarks/bench_grading.py``)."""
+        world = item.config.stash.get(world_key, None)
+        if world is not None:
+            self.data.setdefault("sim_seconds", {})[item.nodeid] = round(
+                world.now - self._sim_began, 3)
 
     def pytest_sessionfinish(self) -> None:
         """The run's timing per module and its peak memory, into the report."""

@@ -15,7 +15,7 @@ from autograder.core.errors import StudentFailure
 from autograder.plugin.bag import attach_probe, close_bag, open_bag
 from autograder.plugin.guard import GraphWatch, Wire, graph_watch_key
 from autograder.plugin.probe import WORLD_NODE_NAME
-from autograder.plugin.stash import reporter_key, settings_key, type_watch_key
+from autograder.plugin.stash import reporter_key, settings_key, type_watch_key, world_key
 from autograder.plugin.timing import Timing
 
 if TYPE_CHECKING:
@@ -99,9 +99,11 @@ def world(request: pytest.FixtureRequest, exercise: Exercise,
         bag = open_bag(request, bridge, spec.name)
         bridge.start()
     bridge.on_wait = lambda seconds, held: timing.waited(request.node.nodeid, seconds, held)
+    request.config.stash[world_key] = bridge
     try:
         yield bridge
     finally:
+        request.config.stash[world_key] = None
         bridge.on_wait = None
         with timing.phase(request.node.nodeid, "world_start"):
             bridge.stop()
