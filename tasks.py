@@ -5,7 +5,7 @@
     python3 tasks.py demo      # grade the reference solution of parameter_validation
     python3 tasks.py test      # the fast tier, no gradings: about 100 CPU-s on 2 cores
     python3 tasks.py test-all  # run every test, the gradings in the simulator too (CI)
-    python3 tasks.py lint | bench
+    python3 tasks.py lint | bench | bench-ci
 
 Arguments after the job go to its command (``python3 tasks.py test -k reporter``).
 
@@ -58,6 +58,11 @@ JOBS = {
     "lint": [["ruff", "check", "."]],
     "bench": [["python", "benchmarks/bench_grading.py"], ["python", "benchmarks/bench_sim.py"],
               ["python", "benchmarks/bench_peers.py"]],
+    # CI's figures, printed into its log after the tests (never pass or fail on time): a
+    # grading of each exercise and a batch of four at --jobs auto; a minute or two.
+    "bench-ci": [["python", "benchmarks/bench_grading.py", "--runs", "1"],
+                 ["python", "benchmarks/bench_batch.py", "--students", "4", "--jobs", "auto",
+                  "--exercise", "parameter_validation"]],
 }
 
 

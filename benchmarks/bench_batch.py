@@ -2,6 +2,9 @@
 --jobs, in wall seconds and students per hour, and whether every score was full (the batch
 must never change a verdict).  Heavy: run it under `flock /tmp/agheavy.lock`.
 
+With ``auto``, the jobs column lists each concurrency chosen, in order (the batch chooses
+again as gradings end), and each line auto printed follows the row.
+
 "late cmds" sums the results' ``pacing.late_commands`` over the batch: commands a world
 took in a later tick than the one they were sent in (ticks that went on without them; the
 tests allow one tick), with the most sim seconds one was late.  Students whose score was
@@ -47,14 +50,15 @@ def run(exercise: Exercise, copies: int, jobs: str, workdir: Path) -> dict[str, 
     with book.open(encoding="utf-8") as fh:
         rows = list(csv.DictReader(fh)) if proc.returncode == 0 else []
     full = len(rows) == copies and all(r["score"] == r["max_score"] for r in rows)
-    chosen = CHOSEN.search(proc.stderr)
+    chosen = list(CHOSEN.finditer(proc.stderr))  # auto chooses again as gradings end
     late, latest, lost = _results(folder / "out")
-    return {"exercise": exercise.id, "jobs": jobs + (f" ({chosen[1]})" if chosen else ""),
+    steps = "->".join(c[1] for c in chosen)
+    return {"exercise": exercise.id, "jobs": jobs + (f" ({steps})" if chosen else ""),
             "wall s": f"{wall:.1f}", "s/student": f"{wall / copies:.1f}",
             "students/h": f"{3600 * copies / wall:.0f}",
             "all full": "yes" if full else f"NO ({proc.returncode})",
             "late cmds": f"{late} ({latest:.2f} s)" if late else "0",
-            "said": chosen[0] if chosen else "", "lost": "; ".join(lost)}
+            "said": "\n  ".join(c[0] for c in chosen), "lost": "; ".join(lost)}
 
 
 def _results(out: Path) -> tuple[int, float, list[str]]:

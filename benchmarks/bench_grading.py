@@ -6,6 +6,12 @@ the runs) and the peak memory of a grading (``memory``, the largest over the run
 children's resident sizes summed, an upper bound, and the footprint, the whole grading's
 PSS summed (see autograder/grading/footprint.py).
 
+Then the floor: the simulation seconds the tests took to their verdicts (setup and call;
+time stands still while a node starts), summed, over the exercise's real-time factor: the
+least wall time the tests could take at the exercise's pace, one after another; "longest
+module" is the same for the module that takes longest, the least with modules at once. The
+ratio is the grading's median wall time over the floor (one after another).
+
 It also prints the CPU seconds of a grading (the grader's and every program it started,
 median) and what they make a floor for a class: a batch cannot grade 100 students of
 every exercise listed in less than their CPU seconds over the machine's cores, however
@@ -46,6 +52,7 @@ def main() -> None:
     timings: dict[str, list[dict[str, Any]]] = {}
     memory: dict[str, list[dict[str, float]]] = {}
     cpu_medians: dict[str, float] = {}
+    floors: dict[str, tuple[float, float, float, float]] = {}
     for exercise in exercises:
         walls, cpus, startups, scores = [], [], [], set()
         ticks: collections.Counter[str] = collections.Counter()
@@ -64,6 +71,8 @@ def main() -> None:
                 ticks.update({k: v for k, v in module.items() if k in ("idle", "budget", "cap")})
         startup = f"{statistics.median(startups):.2f} s" if startups else "-"
         cpu_medians[exercise.id] = statistics.median(cpus)
+        floors[exercise.id] = _floor(timings[exercise.id], exercise.real_time_factor,
+                                     statistics.median(walls))
         print(f"{exercise.id:<22} {','.join(sorted(scores)):>7} "
               f"{statistics.median(walls):>10.2f} s {min(walls):>6.2f} {max(walls):>6.2f} "
               f"{cpu_medians[exercise.id]:>9.1f} s "
@@ -72,6 +81,12 @@ def main() -> None:
     # this process, about 20 MB more of this process's PSS in each grading's footprint.
     from autograder.plugin.timing import PHASES
 
+    print("\nthe floor (median over runs): sim seconds to the verdicts over the real-time "
+          "factor")
+    print(f"{'exercise':<22} {'sim s':>8} {'floor s':>9} {'longest module s':>17} "
+          f"{'wall/floor':>11}")
+    for name, (sim, floor, longest, ratio) in floors.items():
+        print(f"{name:<22} {sim:>8.1f} {floor:>9.2f} {longest:>17.2f} {ratio:>11.2f}")
     columns = ("child_start", *PHASES, "checks", "rest", "total")
     print("\nwhere the seconds went (median over runs, summed over test modules; rest: "
           "the grader's own work outside the tests)")
@@ -95,6 +110,22 @@ def main() -> None:
         print(f"{name:<22} {peak.get('grader_mb', 0.0):>8.1f} "
               f"{peak.get('student_mb', 0.0):>8.1f} {peak.get('total_mb', 0.0):>8.1f} "
               f"{footprint}")
+
+
+def _floor(timings: Sequence[dict[str, Any]], rtf: float,
+           wall: float) -> tuple[float, float, float, float]:
+    """(sim seconds summed, floor, longest module's floor, wall over floor), medians over
+    the runs' ``timing``; floors are 0 for an exercise without a pace (``rtf`` 0)."""
+    sums, longest = [], []
+    for timing in timings:
+        by_module: collections.Counter[str] = collections.Counter()
+        for nodeid, seconds in (timing.get("sim_seconds") or {}).items():
+            by_module[nodeid.partition("::")[0]] += seconds
+        sums.append(sum(by_module.values()))
+        longest.append(max(by_module.values(), default=0.0))
+    sim, most = statistics.median(sums), statistics.median(longest)
+    floor = sim / rtf if rtf > 0 else 0.0
+    return sim, floor, most / rtf if rtf > 0 else 0.0, wall / floor if floor else 0.0
 
 
 def _phases(timing: dict[str, Any], phases: Sequence[str]) -> dict[str, float]:

@@ -5,8 +5,9 @@ soon as they are graded, atomically; running the batch again skips every student
 results are there, so a crash halfway loses nothing already graded.  ``--shard I/N``
 grades a stable share: a student's shard is a hash of their name, so it never moves when
 others are added.  Parallel gradings each hold their own ROS domain: no cross-talk.
-``jobs`` may be a chooser (``--jobs auto``): the first student is graded alone, measured,
-and the chooser picks the concurrency for the rest (:mod:`autograder.grading.capacity`).
+``jobs`` may be a chooser (``--jobs auto``): the first student is graded alone, and as
+each grading ends the chooser picks the concurrency for the rest from what the gradings so
+far showed (:mod:`autograder.grading.capacity`).
 """
 
 from __future__ import annotations
@@ -14,17 +15,21 @@ from __future__ import annotations
 import hashlib
 import json
 import threading
+import time
+from collections import deque
 from collections.abc import Callable
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
 from pathlib import Path
 
 from autograder.commands import gradebook
 from autograder.core.files import write_atomically
 from autograder.core.results import RunResult
-from autograder.grading.capacity import measured
+from autograder.grading.capacity import MAX_JOBS
 
-# Given the first grading's CPU share (cores) and the students left, how many at once.
-Chooser = Callable[[float, int], int]
+# Told of each grading as it ends (its wall seconds, its results, how many ran at once
+# then, itself included, and how many students are left, running or not), the
+# concurrency for the rest.
+Chooser = Callable[[float, RunResult, int, int], int]
 
 
 def students(folder: Path, suffix: str | None = None) -> dict[str, Path]:
@@ -78,34 +83,44 @@ def run_batch(entries: dict[str, Path], grade_one: Callable[[Path], RunResult], 
               ) -> list[gradebook.Row]:
     """Grade every entry in this shard that has no results yet; write the gradebook.
 
-    With a chooser for ``jobs``, the first student to grade is graded alone and measured
-    and the chooser sets the concurrency for the others."""
+    With a chooser for ``jobs``, the first student to grade is graded alone, and the
+    chooser sets the concurrency again each time a grading ends (never above
+    :data:`~autograder.grading.capacity.MAX_JOBS`)."""
     mine = {s: p for s, p in entries.items() if in_shard(s, shard)}
     todo = {s: p for s, p in mine.items() if not _results_path(out, s).exists()}
     lock = threading.Lock()
 
-    def work(student: str, path: Path, first: bool = False) -> float:
-        result, share = measured(lambda: grade_one(path)) if first else (grade_one(path), 0.)
+    def work(student: str, path: Path) -> tuple[RunResult, float]:
+        began = time.monotonic()
+        result = grade_one(path)
+        wall = time.monotonic() - began
         _save(out, student, result, extra)
         with lock:
             _write_gradebook(out, mine, csv_path)
             if progress:
                 progress(student, result)
-        return share
+        return result, wall
 
     for student in sorted(set(mine) - set(todo)):
         if progress:
             progress(student, None)
-    queue = sorted(todo.items())
-    if callable(jobs):
-        if len(queue) > 1:
-            share = work(*queue.pop(0), first=True)
-            jobs = jobs(share, len(queue))
-        else:
-            jobs = 1
-    with ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
-        for future in [pool.submit(work, s, p) for s, p in queue]:
-            future.result()
+    queue = deque(sorted(todo.items()))
+    chooser = jobs if callable(jobs) else None
+    limit = 1 if chooser is not None else max(1, int(jobs))  # type: ignore[arg-type]
+    running: set[Future[tuple[RunResult, float]]] = set()
+    workers = min(MAX_JOBS, len(queue)) if chooser is not None else limit
+    with ThreadPoolExecutor(max_workers=max(1, workers)) as pool:
+        while queue or running:
+            while queue and len(running) < limit:
+                running.add(pool.submit(work, *queue.popleft()))
+            done, _pending = wait(running, return_when=FIRST_COMPLETED)
+            at_once = len(running)
+            running -= done
+            for future in done:
+                result, wall = future.result()
+                if chooser is not None and queue:
+                    limit = max(1, min(workers, chooser(wall, result, at_once,
+                                                        len(queue) + len(running))))
     return _write_gradebook(out, mine, csv_path)
 
 

@@ -3,7 +3,9 @@
 A grading paced by the simulated clock spends most of its wall time waiting for the next
 tick, so several share a core; a CPU-bound one (``real_time_factor: 0``) fills a core by
 itself.  :func:`choose_jobs` is a pure function of the machine (cores, free memory) and of
-one grading (its CPU share, its memory); the rest of this module reads those inputs.
+a grading (its CPU share, its memory); :class:`Tally` keeps what the gradings finished so
+far showed, so that the choice is made again as each one ends (:func:`auto_chooser`); the
+rest of this module reads those inputs.
 """
 
 from __future__ import annotations
@@ -12,35 +14,35 @@ import dataclasses
 import math
 import os
 import resource
+import threading
 import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Literal, TypeVar
 
+from autograder.core.results import RunResult
 from autograder.i18n import _, ngettext
 
 # Cores the gradings may ask for together, as a multiple of the cores there are. Above 1:
-# a grading measured alone also waits on things that do not need a CPU (the clock's wall
-# deadlines, a node's exit), and its demand comes in bursts (start-up, then ticks), so the
-# gaps are filled only well past the cores; past that each grading only stretches, the
-# pacing holding simulation time for a process that waits for a CPU. On 2 cores
-# error_handling's 16 students went at 294 an hour at 0.75 (3 at once), 448 at 1.25 (5)
-# and 596 with 8 at once (2.0 at its 0.46 of a core), and 8 at once graded faster than 4
-# for every exercise but parameter_validation, and than 1.25's choice for all five, every
-# score full (docs/contributors/measurements.md). A grading that fills a core by itself
-# gets two per core: no faster, no slower.
+# a grading also waits on things that need no CPU (the clock's wall deadlines, a node's
+# exit) and its demand comes in bursts, so the gaps fill only well past the cores; past
+# that each grading only stretches, the pacing holding simulation time for a process that
+# waits for a CPU (the figures: docs/contributors/measurements.md, "--jobs auto").
 TARGET_LOAD = 2.0
-# Most gradings at once: the highest concurrency measured to keep every score full
-# (docs/contributors/measurements.md, benchmarks/bench_batch.py).
+# Most gradings at once: the most shown to keep every score full (the same section).
 MAX_JOBS = 8
-# Resident memory of one grading (pytest child, simulator, student node), measured ~250 MB;
-# rounded up so a node that allocates more still fits.
+# Resident memory of one grading (pytest child, simulator, student node), with room for a
+# node that allocates more than a reference solution does.
 GRADING_MB = 400.0
 # Least CPU share believed of a grading: a first student that only hangs measures little.
 MIN_SHARE = 0.15
 CGROUP = Path("/sys/fs/cgroup")
 
-Bound = Literal["cpu", "memory", "students", "ceiling"]
+# A measured footprint (the PSS of a grading's whole tree) times this is what a grading is
+# believed to need: students' programs differ, and the footprint is sampled once a second.
+MEMORY_MARGIN = 1.5
+
+Bound = Literal["cpu", "memory", "students", "ceiling", "strained"]
 T = TypeVar("T")
 
 
@@ -57,15 +59,19 @@ class Choice:
 
 
 def choose_jobs(*, cores: float, memory_mb: float, cpu_share: float, grading_mb: float,
-                students: int, ceiling: int = MAX_JOBS, load: float = TARGET_LOAD) -> Choice:
+                students: int, ceiling: int = MAX_JOBS, load: float = TARGET_LOAD,
+                strained: int | None = None) -> Choice:
     """Gradings at once: as many as keep ``load`` of ``cores`` busy at ``cpu_share`` cores
-    each, fit in ``memory_mb`` at ``grading_mb`` each, and no more than ``students`` or
-    ``ceiling``; always at least one."""
+    each, fit in ``memory_mb`` at ``grading_mb`` each, and no more than ``students``,
+    ``ceiling`` or ``strained`` (fewer than the most at once seen to starve a student's
+    program); always at least one."""
     share = max(cpu_share, MIN_SHARE)
     limits: dict[Bound, int] = {"cpu": math.floor(cores * load / share + 1e-9)}
     if grading_mb > 0 and math.isfinite(memory_mb):  # unknown free memory bounds nothing
         limits["memory"] = math.floor(memory_mb / grading_mb)
     limits.update(students=students, ceiling=ceiling)
+    if strained is not None:
+        limits["strained"] = strained
     bound = min(limits, key=lambda name: limits[name])  # first listed wins a tie
     return Choice(max(1, limits[bound]), bound, cores, share, memory_mb, grading_mb)
 
@@ -77,17 +83,20 @@ def describe(choice: Choice) -> str:
         jobs=choice.jobs)
     share, cores = f"{choice.cpu_share:.2f}", f"{choice.cores:g}"
     if choice.bound == "cpu":
-        why = _("Bound by the CPU: the first grading used {share} of a core, on {cores} "
-                "cores.").format(share=share, cores=cores)
+        why = _("Bound by the CPU: a grading uses {share} of a core as measured so far, on "
+                "{cores} cores.").format(share=share, cores=cores)
     elif choice.bound == "memory":
         why = _("Bound by memory: {free} MB free, about {each} MB per grading.").format(
             free=round(choice.memory_mb), each=round(choice.grading_mb))
     elif choice.bound == "students":
-        why = _("Every student left to grade at once (the first grading used {share} of a "
-                "core, on {cores} cores).").format(share=share, cores=cores)
+        why = _("Every student left to grade at once (a grading uses {share} of a core as "
+                "measured so far, on {cores} cores).").format(share=share, cores=cores)
+    elif choice.bound == "strained":
+        why = _("At most {jobs}: with more at once, a student's program had to wait for a "
+                "CPU longer than the world holds its clock for it.").format(jobs=choice.jobs)
     else:
-        why = _("At most {ceiling}, the most measured to keep every score (the first "
-                "grading used {share} of a core, on {cores} cores).").format(
+        why = _("At most {ceiling}, the most measured to keep every score (a grading uses "
+                "{share} of a core as measured so far, on {cores} cores).").format(
             ceiling=choice.jobs, share=share, cores=cores)
     return f"{head} {why}"
 
@@ -170,14 +179,100 @@ def measured(work: Callable[[], T]) -> tuple[T, float]:
     return value, (_cpu_seconds() - cpu) / elapsed if elapsed > 0 else 0.0
 
 
-def auto_chooser(report: Callable[[str], None] | None = None,
-                 grading_mb: float = GRADING_MB) -> Callable[[float, int], int]:
-    """What ``run_batch`` calls with the first grading's CPU share and the students left:
-    the concurrency for this machine, told to ``report`` in one line."""
-    def choose(cpu_share: float, students: int) -> int:
-        choice = choose_jobs(cores=machine_cores(), memory_mb=machine_memory_mb(),
-                             cpu_share=cpu_share, grading_mb=grading_mb, students=students)
-        if report is not None:
-            report(describe(choice))
-        return choice.jobs
-    return choose
+@dataclasses.dataclass(frozen=True)
+class Tally:
+    """What the gradings of a batch finished so far showed: the first one's wall time (it
+    ran alone: the wall a grading takes without others), their CPU seconds summed (the
+    grader's and every program it started), the largest footprint, and the most gradings
+    that ran at once while one of them starved a student's program (None: never)."""
+
+    first_wall: float = 0.0
+    graded: int = 0
+    cpu_seconds: float = 0.0
+    footprint_mb: float | None = None
+    strained_at: int | None = None
+
+    def add(self, *, wall: float, cpu_seconds: float, footprint_mb: float | None,
+            strained: bool, at_once: int) -> Tally:
+        """This tally with one more grading: its wall, the batch's CPU seconds since the
+        last one ended, its footprint, whether it starved a student's program and how many
+        gradings were running when it ended (itself included)."""
+        peaks = [m for m in (self.footprint_mb, footprint_mb) if m is not None]
+        strained_at = self.strained_at
+        if strained:
+            strained_at = at_once if strained_at is None else min(strained_at, at_once)
+        return Tally(first_wall=self.first_wall if self.graded else wall,
+                     graded=self.graded + 1, cpu_seconds=self.cpu_seconds + cpu_seconds,
+                     footprint_mb=max(peaks) if peaks else None, strained_at=strained_at)
+
+    @property
+    def cpu_share(self) -> float:
+        """The cores a grading keeps busy when it runs alone: its CPU seconds (the mean so
+        far) over the first grading's wall. Walls at concurrency are not used: contention
+        stretches them, and a share read from them would fall as concurrency rises and
+        raise it again."""
+        if not self.graded or self.first_wall <= 0:
+            return 0.0
+        return self.cpu_seconds / self.graded / self.first_wall
+
+    def grading_mb(self, default: float = GRADING_MB) -> float:
+        """Memory a grading is believed to need: the largest footprint seen with a margin,
+        else ``default``."""
+        return default if self.footprint_mb is None else self.footprint_mb * MEMORY_MARGIN
+
+
+def decide(tally: Tally, *, cores: float, memory_mb: float, students: int,
+           ceiling: int = MAX_JOBS) -> Choice:
+    """The concurrency for the ``students`` left from what ``tally`` showed: as
+    :func:`choose_jobs`, and one fewer than the most at once that starved a student."""
+    strained = None if tally.strained_at is None else max(1, tally.strained_at - 1)
+    return choose_jobs(cores=cores, memory_mb=memory_mb, cpu_share=tally.cpu_share,
+                       grading_mb=tally.grading_mb(), students=students, ceiling=ceiling,
+                       strained=strained)
+
+
+def starved(result: RunResult) -> bool:
+    """Whether a grading's results show a student's program starved of CPU: a world that
+    went on at its wall cap while the program still had work (``pacing``)."""
+    return any(module.get("cap", 0) for module in result.pacing.values())
+
+
+class AutoChooser:
+    """``--jobs auto`` for ``run_batch``: told of each grading as it ends, it gives the
+    concurrency for the rest (see :func:`decide`) and tells ``report`` when it changes."""
+
+    def __init__(self, report: Callable[[str], None] | None = None,
+                 cores: Callable[[], float] | None = None,
+                 memory_mb: Callable[[], float] | None = None,
+                 cpu: Callable[[], float] | None = None) -> None:
+        self._report = report
+        self._cores = cores or machine_cores
+        self._memory_mb = memory_mb or machine_memory_mb
+        self._cpu = cpu or _cpu_seconds
+        self._lock = threading.Lock()
+        self._last_cpu = self._cpu()
+        self.tally = Tally()
+        self.jobs: int | None = None
+
+    def __call__(self, wall: float, result: RunResult, at_once: int, students: int) -> int:
+        """One grading ended after ``wall`` seconds with ``result``, ``at_once``
+        running then (itself included), ``students`` left to grade (running or not)."""
+        with self._lock:
+            now = self._cpu()
+            memory = result.memory
+            self.tally = self.tally.add(wall=wall, cpu_seconds=now - self._last_cpu,
+                                        footprint_mb=memory.get("footprint_mb"),
+                                        strained=starved(result), at_once=at_once)
+            self._last_cpu = now
+            choice = decide(self.tally, cores=self._cores(), memory_mb=self._memory_mb(),
+                            students=max(1, students))
+            if choice.jobs != self.jobs and self._report is not None:
+                self._report(describe(choice))
+            self.jobs = choice.jobs
+            return choice.jobs
+
+
+def auto_chooser(report: Callable[[str], None] | None = None) -> AutoChooser:
+    """What ``run_batch`` calls as each grading ends: the concurrency for this machine
+    and the gradings so far, told to ``report`` in one line whenever it changes."""
+    return AutoChooser(report)

@@ -81,7 +81,7 @@ def merge(reports: Sequence[RawReport], order: Sequence[str]) -> RawReport:
                      output_log="\n\n".join(r.output_log for r in reports if r.output_log))
 
 
-_DICTS = ("logs", "recordings", "pacing", "bags", "timing")
+_DICTS = ("logs", "recordings", "pacing", "bags", "timing", "sim_seconds")
 _LISTS = ("log_files", "processes", "startup_seconds", "warnings")
 
 

@@ -214,10 +214,9 @@ def _run(exercise: Exercise, submission: Path | None, plan: _Plan,
          ) -> tuple[RunResult, RawReport]:
     """One grading in child pytests, one per reserved domain; the result and the merged
     raw report. Each child gets its :class:`~autograder.core.settings.RunSettings` as one
-    document (see :mod:`autograder.grading.children`). A single child forks students'
-    programs from a zygote (it runs every module's, and a batch's CPU is what it saves);
-    children at once exec them (a zygote each would add about 20 MB each to the grading's
-    memory, for a start or two a child)."""
+    document (see :mod:`autograder.grading.children`). Every child forks students'
+    programs from a zygote of its own (in its own namespaces), so each start after the
+    first is a fork, not an exec (docs/contributors/design.md, "Warm starts")."""
     targets = plan.targets(len(locks))
     settings = RunSettings(
         domains=tuple(lock.domain for lock in locks),
@@ -239,7 +238,7 @@ def _run(exercise: Exercise, submission: Path | None, plan: _Plan,
                         run_prefix(isolation),
                         dataclasses.replace(settings, count_only=count_only),
                         [str(t) for t in group], Path(tmp) / f"child-{index}",
-                        exercise.folder, lock, zygote=len(targets) == 1)))
+                        exercise.folder, lock)))
                 footprint = Footprint([child.process.pid for child in running])
                 children.wait(running, exercise.time_limit, watchers, footprint)
         except BaseException:  # stopped (a signal, Ctrl-C): the children go before tmp
@@ -272,13 +271,15 @@ def _timing(data: dict[str, Any], launched: float, elapsed: float) -> dict[str, 
     the first test: pytest, the plugin, collecting the tests), the tests (per module, see
     :mod:`autograder.plugin.timing`; summed, so more than ``total`` when modules run at
     once) and the total, from the grader's call. ``launched`` is when the first child was
-    started (the monotonic clock, the same in every process)."""
+    started (the monotonic clock, the same in every process). ``sim_seconds``: each
+    test's simulation seconds to its verdict, by node id (see the reporter)."""
     modules = data.get("timing", {})
     first = data.get("first_test_at")
     child_start = None if first is None else round(max(0.0, first - launched), 3)
     return {"child_start": child_start,
             "tests": round(sum(m.get("total", 0.0) for m in modules.values()), 3),
-            "total": round(elapsed, 3), "modules": modules}
+            "total": round(elapsed, 3), "modules": modules,
+            "sim_seconds": data.get("sim_seconds", {})}
 
 
 def _fault(exercise: Exercise, details: str, elapsed: float) -> RunResult:

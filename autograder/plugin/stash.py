@@ -18,5 +18,8 @@ credit_key = pytest.StashKey["Credit"]()
 evidence_key = pytest.StashKey["Evidence"]()
 # On a test module: the probe's watch on message types (plugin/msgtypes.py).
 type_watch_key = pytest.StashKey["TypeWatch"]()
+# The world of the test module running now, None between modules (the reporter reads its
+# simulation time around each test).
+world_key = pytest.StashKey["SimBridge | None"]()
 # The student's node failed to appear once: later starts in the run fail at once.
 startup_key = pytest.StashKey[StudentFailure]()

@@ -15,7 +15,7 @@ from autograder.core.errors import StudentFailure
 from autograder.plugin.bag import attach_probe, close_bag, open_bag
 from autograder.plugin.guard import GraphWatch, Wire, graph_watch_key
 from autograder.plugin.probe import WORLD_NODE_NAME
-from autograder.plugin.stash import reporter_key, settings_key, type_watch_key
+from autograder.plugin.stash import reporter_key, settings_key, type_watch_key, world_key
 from autograder.plugin.timing import Timing
 
 if TYPE_CHECKING:
@@ -99,9 +99,11 @@ def world(request: pytest.FixtureRequest, exercise: Exercise,
         bag = open_bag(request, bridge, spec.name)
         bridge.start()
     bridge.on_wait = lambda seconds, held: timing.waited(request.node.nodeid, seconds, held)
+    request.config.stash[world_key] = bridge
     try:
         yield bridge
     finally:
+        request.config.stash[world_key] = None
         bridge.on_wait = None
         with timing.phase(request.node.nodeid, "world_start"):
             bridge.stop()
@@ -129,11 +131,12 @@ def _make_world(exercise: Exercise, spec: WorldSpec, ros_context: Context,
                 rtf: float | None) -> SimBridge:
     """The world for ``spec`` on the run's context, not yet started."""
     from sim.bridge import SimBridge
+    from sim.pacing import PacingPolicy
     from sim.physics import World
 
     return SimBridge(World(spec), ros_context, node_name=WORLD_NODE_NAME,
-                     max_clock_hz=exercise.clock_hz,
-                     cpu_budget=exercise.cpu_budget,
+                     policy=PacingPolicy(clock_hz=exercise.clock_hz,
+                                         cpu_budget=exercise.cpu_budget),
                      real_time_factor=exercise.real_time_factor if rtf is None else rtf,
                      cmd_vel_type=exercise.cmd_vel_type)
 

@@ -1,9 +1,12 @@
-"""--jobs auto: the concurrency chosen from the machine and one grading's CPU share, the
-cgroup files it reads, and the batch grading its first student alone to measure it."""
+"""--jobs auto: the concurrency chosen from the machine and the gradings' CPU share, the
+cgroup files it reads, and the batch grading its first student alone, then choosing again
+as each grading ends."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
+import threading
 from fractions import Fraction
 from pathlib import Path
 
@@ -14,7 +17,15 @@ from autograder.cli import main
 from autograder.commands.batch import run_batch
 from autograder.core.results import RunResult, TestResult
 from autograder.grading import capacity
-from autograder.grading.capacity import Choice, choose_jobs, describe
+from autograder.grading.capacity import (
+    AutoChooser,
+    Choice,
+    Tally,
+    choose_jobs,
+    decide,
+    describe,
+    starved,
+)
 
 MACHINE = {"cores": 2.0, "memory_mb": 8000.0, "grading_mb": 400.0}
 
@@ -42,12 +53,13 @@ def test_a_first_grading_that_only_hangs_is_not_believed_to_cost_nothing() -> No
     assert choice.cpu_share == capacity.MIN_SHARE and choice.jobs == 26
 
 
-@pytest.mark.parametrize("bound", ["cpu", "memory", "students", "ceiling"])
+@pytest.mark.parametrize("bound", ["cpu", "memory", "students", "ceiling", "strained"])
 def test_describe_says_the_number_and_why(bound) -> None:
     line = describe(Choice(3, bound, 2.0, 0.25, 1200.0, 400.0))
     assert line.startswith("--jobs auto: 3 gradings at a time.")
-    assert {"cpu": "0.25 of a core, on 2 cores", "memory": "1200 MB free",
-            "students": "Every student", "ceiling": "At most 3"}[bound] in line
+    assert {"cpu": "0.25 of a core as measured so far, on 2 cores",
+            "memory": "1200 MB free", "students": "Every student", "ceiling": "At most 3",
+            "strained": "At most 3: with more at once"}[bound] in line
     assert "grading at a time." in describe(Choice(1, "cpu", 2.0, 1.0, 1200.0, 400.0))
 
 
@@ -98,26 +110,91 @@ def _result(score: int) -> RunResult:
     return RunResult(kind="exercise", id="ex", title="Ex", tests=(test,))
 
 
-def test_auto_grades_the_first_alone_then_as_many_as_chosen(tmp_path) -> None:
+def test_a_tally_shares_the_mean_cpu_over_the_first_wall() -> None:
+    tally = Tally().add(wall=10.0, cpu_seconds=4.0, footprint_mb=200.0, strained=False,
+                        at_once=1)
+    assert (tally.cpu_share, tally.grading_mb()) == (0.4, 200.0 * capacity.MEMORY_MARGIN)
+    # Later gradings ran beside others: their stretched walls are not the measure.
+    tally = tally.add(wall=30.0, cpu_seconds=2.0, footprint_mb=260.0, strained=False,
+                      at_once=4)
+    assert (tally.graded, tally.first_wall, tally.cpu_share) == (2, 10.0, 0.3)
+    assert tally.grading_mb() == 260.0 * capacity.MEMORY_MARGIN
+    assert Tally().grading_mb() == capacity.GRADING_MB  # nothing measured yet
+
+
+def test_a_starved_student_caps_the_concurrency_below_where_it_happened() -> None:
+    tally = Tally().add(wall=10.0, cpu_seconds=0.5, footprint_mb=None, strained=False,
+                        at_once=1)
+    machine = {"cores": 2.0, "memory_mb": 8000.0, "students": 50}
+    assert decide(tally, **machine).bound == "ceiling"
+    tally = tally.add(wall=12.0, cpu_seconds=0.5, footprint_mb=None, strained=True,
+                      at_once=5)
+    assert (decide(tally, **machine).jobs, decide(tally, **machine).bound) == (4, "strained")
+    tally = tally.add(wall=12.0, cpu_seconds=0.5, footprint_mb=None, strained=True,
+                      at_once=7)  # seen higher too: the lower stays the bound
+    assert decide(tally, **machine).jobs == 4
+    once = Tally().add(wall=1.0, cpu_seconds=0.1, footprint_mb=None, strained=True,
+                       at_once=1)
+    assert decide(once, **machine).jobs == 1  # never fewer than one
+
+
+@pytest.mark.parametrize(("pacing", "expected"), [
+    ({}, False), ({"test_a": {"idle": 40, "budget": 2, "cap": 0}}, False),
+    ({"test_a": {"idle": 40}, "test_b": {"idle": 9, "cap": 1}}, True)],
+    ids=["no-world", "held-within-budget", "cap-hit"])
+def test_starved_reads_the_pacing_cap(pacing, expected) -> None:
+    assert starved(dataclasses.replace(_result(3), pacing=pacing)) is expected
+
+
+def test_the_chooser_decides_again_and_says_so_only_when_the_number_changes() -> None:
+    cpu = iter([0.0, 8.0, 8.5, 12.0, 13.0])  # the batch's CPU at the start and each end
+    said: list[str] = []
+    chooser = AutoChooser(said.append, cores=lambda: 2.0, memory_mb=lambda: 8000.0,
+                          cpu=lambda: next(cpu))
+    plain, starving = _result(3), dataclasses.replace(_result(3), pacing={"m": {"cap": 2}})
+    assert chooser(10.0, plain, 1, 10) == 5  # 0.8 of a core: 2 cores x 2.0 / 0.8
+    assert chooser(20.0, plain, 5, 9) == 8  # a mean of 4.25 s over the first 10 s: 0.425
+    assert chooser(25.0, plain, 8, 8) == 8  # 0.4: still the ceiling, nothing said
+    assert chooser(25.0, starving, 7, 7) == 6  # starved at 7
+    assert [line.split(".")[0] for line in said] == [
+        "--jobs auto: 5 gradings at a time", "--jobs auto: 8 gradings at a time",
+        "--jobs auto: 6 gradings at a time"]
+    assert "longer than the world holds its clock" in said[-1]
+
+
+def test_auto_grades_the_first_alone_then_chooses_as_each_ends(tmp_path) -> None:
     entries = {f"s{i}": tmp_path / f"s{i}" for i in range(5)}
     asked = []
+    running, most = [0], [0]
+    lock = threading.Lock()
+    together = threading.Barrier(2, timeout=60)  # the last two must run at once
 
     def grade_one(path: Path) -> RunResult:
+        with lock:
+            running[0] += 1
+            most[0] = max(most[0], running[0])
+        if path.name in ("s3", "s4"):
+            together.wait()
+        with lock:
+            running[0] -= 1
         return _result(3)
 
-    def chooser(share: float, students: int) -> int:
-        asked.append((share >= 0, students, len(list((tmp_path / "out").iterdir()))))
-        return 2
+    def chooser(wall: float, result: RunResult, at_once: int, left: int) -> int:
+        asked.append((at_once, left, len(list((tmp_path / "out").iterdir()))))
+        return 1 if left > 2 else 3
 
     rows = run_batch(entries, grade_one, tmp_path / "out", tmp_path / "book.csv",
                      jobs=chooser)
-    assert asked == [(True, 4, 1)]  # after the first student, for the four left
+    # One at a time while the chooser said 1 (the first alone), asked after each; then
+    # both left at once (3 asked, 2 left), and no more asking with none waiting.
+    assert asked == [(1, 4, 1), (1, 3, 2), (1, 2, 3)]
+    assert most[0] == 2
     assert len(rows) == 5 and {r["score"] for r in rows} == {"3"}
     assert json.loads((tmp_path / "out/s0/results.json").read_text())["score"] == 3
 
 
 def test_auto_with_one_student_left_chooses_nothing(tmp_path) -> None:
-    def chooser(share: float, students: int) -> int:
+    def chooser(wall: float, result: RunResult, at_once: int, left: int) -> int:
         raise AssertionError("not asked")
 
     rows = run_batch({"only": tmp_path / "only"}, lambda p: _result(2), tmp_path / "out",

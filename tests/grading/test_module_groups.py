@@ -235,7 +235,7 @@ def test_grade_batch_runs_modules_at_once_only_when_it_grades_one_at_a_time(
 
     monkeypatch.setattr(run, "grade", fake_grade)
     monkeypatch.setattr("autograder.grading.capacity.auto_chooser",
-                        lambda report=None: lambda share, students: 2)
+                        lambda report=None: lambda wall, result, at_once, left: 2)
     (tmp_path / "subs").mkdir()
     for student in ("alice", "bob"):
         (tmp_path / "subs" / f"{student}.py").write_text("")
@@ -263,3 +263,11 @@ def test_a_childs_report_is_parsed_again_only_when_it_changed(
     assert len(parsed) == 2
     report.write(path, [_test(PUBLIC, "test_one")], {}, b"x" * 32)  # not ours: forged
     assert child.reported_tests() == []
+
+
+def test_each_childs_sim_seconds_are_joined_for_the_floor() -> None:
+    first = RawReport(tests=[], data={"sim_seconds": {"tests/public/test_a.py::t1": 2.5}})
+    second = RawReport(tests=[], data={"sim_seconds": {"tests/hidden/test_b.py::t2": 4.0}})
+    merged = merge([first, second], ["tests/public/test_a.py", "tests/hidden/test_b.py"])
+    assert merged.data["sim_seconds"] == {"tests/public/test_a.py::t1": 2.5,
+                                          "tests/hidden/test_b.py::t2": 4.0}

@@ -188,3 +188,48 @@ def test_receiving_counts_packets_the_kernel_still_holds(tmp_path) -> None:
     assert backlog(str(stat)) == 0
     assert backlog(str(tmp_path / "missing")) == 0
     assert backlog() >= 0  # this machine's
+
+
+# Starts a thread that spins, says so, and ends it on a line from the test; repeats.
+THREADS = [sys.executable, "-c", """
+import sys, threading
+while sys.stdin.readline():
+    stop = threading.Event()
+    def spin():
+        while not stop.is_set():
+            pass
+    thread = threading.Thread(target=spin)
+    thread.start()
+    print("spinning", flush=True)
+    sys.stdin.readline()
+    stop.set()
+    thread.join()
+    print("ended", flush=True)
+"""]
+
+
+def _open_fds() -> int:
+    return len(os.listdir("/proc/self/fd"))
+
+
+def test_kept_files_follow_threads_that_come_and_go_and_close_with_the_process() -> None:
+    before = _open_fds()
+    proc = subprocess.Popen(THREADS, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                            text=True)
+    assert proc.stdin is not None and proc.stdout is not None
+    try:
+        for _round in range(3):  # a new thread each round, perhaps under an old number
+            assert _poll(lambda: not read_process_state(proc.pid).busy)  # the main thread waits
+            proc.stdin.write("go\n")
+            proc.stdin.flush()
+            assert proc.stdout.readline() == "spinning\n"
+            assert _poll(lambda: read_process_state(proc.pid).busy)  # the new thread
+            proc.stdin.write("stop\n")
+            proc.stdin.flush()
+            assert proc.stdout.readline() == "ended\n"
+    finally:
+        proc.stdin.close()
+        proc.wait()
+        proc.stdout.close()
+    assert read_process_state(proc.pid) == IDLE  # gone: its files are closed
+    assert _open_fds() == before
