@@ -11,7 +11,7 @@ from autograder.core.exercise import find_exercise
 from autograder.grading.children import pytest_env
 from autograder.grading.run import grade
 
-STARTER = (Path(__file__).resolve().parent.parent / "assignments" / "parameter_validation"
+STARTER = (Path(__file__).resolve().parents[2] / "assignments" / "parameter_validation"
            / "starter")
 
 
