@@ -211,7 +211,7 @@ def test_the_platforms_own_catalogs_are_current_and_complete(tmp_path: Path) -> 
     from autograder.i18n.glossary import check_all
     from autograder.i18n.tools import extract
 
-    root = Path(__file__).resolve().parent.parent
+    root = Path(__file__).resolve().parents[2]
     for fresh in extract(root, tmp_path):
         with fresh.open("rb") as fh:
             now = {(m.context, m.id) for m in read_po(fh) if m.id}
