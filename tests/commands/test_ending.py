@@ -164,8 +164,17 @@ def assert_nothing_left(work: Work, output: str) -> None:
         output + "\n".join(described(pid) for pid, _cwd in processes))
 
 
+def as_a_terminal_starts_it() -> None:
+    """Ctrl-C and Ctrl-\\ at their defaults, as in a terminal: a test run from a shell's
+    background job inherits them ignored, and so would the command, which Ctrl-C could
+    then not end."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+    signal.signal(signal.SIGQUIT, signal.SIG_DFL)
+
+
 def started(case: Case, work: Work, **popen: object) -> subprocess.Popen[bytes]:
     return subprocess.Popen(work.command(case.args(work)), cwd=work.folder, env=work.env(),
+                            preexec_fn=as_a_terminal_starts_it,
                             **popen)  # type: ignore[call-overload]
 
 
