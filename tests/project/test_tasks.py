@@ -31,7 +31,9 @@ def test_test_is_the_fast_tier_and_test_all_is_everything():
     assert fast[fast.index("-m", 3) + 1] == "not slow"
     assert then[then.index("-m", 3) + 1] == "slow" and "-n" not in then
     ci = (ROOT / ".ci" / "run").read_text()
-    assert re.findall(r"^python3 tasks\.py (\S+)", ci, re.M) == ["test-all"]
+    # The whole suite, then the benchmarks kept with the run (never a test's pass or fail).
+    assert re.findall(r"^python3 tasks\.py (\S+)", ci, re.M) == ["test-all", "bench-ci"]
+    assert re.search(r"^python3 tasks\.py bench-ci \|\| ", ci, re.M)
 
 
 def test_make_and_readme_name_only_jobs_of_tasks_py():
