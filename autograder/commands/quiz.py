@@ -1,7 +1,8 @@
 """``autograder quiz``: what each of its commands does, as plain functions that return what
-is to be printed. Bad input (a malformed or missing quiz, answers or catalog file, a port in
-use) is a :class:`~autograder.core.errors.UsageError` or a
-:class:`~autograder.core.errors.ContentError`; the CLI turns them into exit codes.
+is to be printed (``take`` and ``serve`` talk through a :class:`Console`). Bad input (a
+malformed or missing quiz, answers or catalog file, a port in use) is a
+:class:`~autograder.core.errors.UsageError` or a :class:`~autograder.core.errors.ContentError`;
+the CLI turns them into exit codes.
 """
 
 from __future__ import annotations
@@ -42,8 +43,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "SHORT", "Console", "NotLoaded", "Scored", "answer_key", "export_quizzes", "lint_problems",
-    "quiz_list",
-    "render_quizzes", "score_answers", "serve_quizzes", "summary", "take_quiz",
+    "quiz_list", "render_quizzes", "score_answers", "serve_quizzes", "summary", "take_quiz",
     "use_language",
 ]
 
