@@ -3,7 +3,7 @@
 
     python3 tasks.py setup     # only make .venv and install the platform into it
     python3 tasks.py demo      # grade the reference solution of parameter_validation
-    python3 tasks.py test      # the fast tier, no gradings: about 100 CPU-s on 2 cores
+    python3 tasks.py test      # the fast tier, no gradings: under a minute on 2 cores
     python3 tasks.py test-all  # run every test, the gradings in the simulator too (CI)
     python3 tasks.py lint | bench | bench-ci
 
