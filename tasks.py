@@ -35,19 +35,25 @@ STAMP = VENV / ".installed"
 NON_ROS_DEPENDENCIES = ["pymunk>=6.6", "numpy>=1.24", "jinja2>=3.1", "babel>=2.12",
                         "click>=8.1", "pytest>=7.4", "pyyaml>=6.0", "mcap>=1.1",
                         "mcap-ros2-support>=0.5", "ruff>=0.5", "playwright>=1.40",
-                        "kubernetes-validate>=1.37", "mkdocs-material>=9.5"]
+                        "kubernetes-validate>=1.37", "mkdocs-material>=9.5",
+                        "pytest-xdist>=3.5"]
 
+# Files of the fast tier run in parallel, one worker per core and each file whole on one
+# worker (its module fixtures made once); no fast test shares state across files.
+FAST = ["python", "-m", "pytest", "-m", "not slow", "-n", "auto", "--dist", "loadfile",
+        "--durations=10"]
 JOBS = {
     # Only the set-up: what a student release offers (it has no solution to grade).
     "setup": [],
     "demo": [["autograder", "grade", "parameter_validation",
               "assignments/parameter_validation/solution"]],
     # The fast tier: everything but the tests marked `slow` (each grades submissions end to
-    # end in the simulator): about a minute on an idle 2-core machine, 2 to 3 under load.
-    "test": [["python", "-m", "pytest", "-m", "not slow", "--durations=10"]],
-    # Everything, as CI runs it (about 30 minutes on 2 cores: 28 min 41 s). The ten
-    # slowest steps close the run: where the suite's minutes go, in every CI log.
-    "test-all": [["python", "-m", "pytest", "--durations=10"]],
+    # end in the simulator), a test file per core at a time (pytest-xdist).
+    "test": [FAST],
+    # Everything, as CI runs it: the fast tier as above, then the gradings one file at a
+    # time (each file already grades two at a time, which is what 2 cores hold). The ten
+    # slowest steps close each: where the suite's minutes go, in every CI log.
+    "test-all": [FAST, ["python", "-m", "pytest", "-m", "slow", "--durations=10"]],
     "lint": [["ruff", "check", "."]],
     "bench": [["python", "benchmarks/bench_grading.py"], ["python", "benchmarks/bench_sim.py"],
               ["python", "benchmarks/bench_peers.py"]],
@@ -61,7 +67,7 @@ JOBS = {
 
 # The dev extra's packages: only the project's own tests and docs use them, so the demo,
 # a student's set-up, installs without them (playwright alone is 165 MB).
-DEV_ONLY = ("ruff", "playwright", "kubernetes-validate", "mkdocs-material")
+DEV_ONLY = ("ruff", "playwright", "kubernetes-validate", "mkdocs-material", "pytest-xdist")
 
 
 def _size_mb(folder: Path) -> int:

@@ -41,8 +41,8 @@ anything else is reported as the grader's error, never as their zero.
 from __future__ import annotations
 
 from autograder.core.errors import GraderError, StudentFailure
-from autograder.plugin import MARKERS
 from autograder.plugin.credit import Credit, Evidence
+from autograder.plugin.markers import MARKERS
 from autograder.plugin.probe import Inbox, Probe
 from autograder.plugin.student import StudentNode
 from sim.bridge import SimBridge

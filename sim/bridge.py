@@ -5,9 +5,7 @@ the bridge publishes ``/clock`` (the tick's end time) and then the odometry and 
 fell due inside it, so a subscriber's clock has already reached a message's stamp.
 Commands on ``/cmd_vel`` are taken by the world's own thread at the start of each tick, not
 by an executor: every command the node's middleware has handed to the bridge by then drives
-that tick.  (An executor thread took them before; with eight gradings on two cores it was
-left without a CPU for up to 0.4 s of sim time while the world ticked on under the old
-command: a correct node's stop came late, and a batch changed a verdict.)
+that tick, however long an executor thread would wait for a CPU.
 
 What goes out is what a TurtleBot3 on Jazzy gives (REP 105 frames): ``/odom`` is wheel
 odometry in the ``odom`` frame, which starts at (0, 0, 0) where the robot starts, with
@@ -20,7 +18,8 @@ publishers of the other type, which the robot cannot hear.
 
 How long a tick is and when the next may go (the real-time factor, at most ``clock_hz``
 ticks per wall second, holding for a busy student process, the start-up hold) is decided
-by :class:`sim.pacing.Pacer`; the bridge only steps the world and publishes.
+by :class:`sim.pacing.Pacer` under a :class:`sim.pacing.PacingPolicy`; the bridge only
+steps the world and publishes.
 ``effective_rtf`` reports the measured sim seconds per wall second of the last ticks.
 
 Physics runs in one thread and an executor in another (the node serves no parameter
@@ -56,9 +55,9 @@ from sim.cmdvel import CMD_VEL_TOPIC, MESSAGE_TYPES, Mismatch, full_name, mismat
 from sim.engine import SCAN_HZ, Outputs, Simulation
 from sim.faults import Scan
 from sim.msgdefs import type_name
-from sim.pacing import DEFAULT_CLOCK_HZ, DEFAULT_CPU_BUDGET, HoldOutcome, Pacer, PacingPolicy
+from sim.pacing import HoldOutcome, Pacer, PacingPolicy
 from sim.physics import World
-from sim.procstate import Receiving
+from sim.procstate import Receiving, backlog
 from sim.recorder import Recording, Sample
 from sim.worldfile import CmdVelType, Fault
 
@@ -89,10 +88,7 @@ class SimBridge:
     SUBSCRIBES = ("/cmd_vel",)
 
     def __init__(self, world: World, context: Context, *, real_time_factor: float = 1.0,
-                 max_clock_hz: float = DEFAULT_CLOCK_HZ, node_name: str = "sim_world",
-                 quiescence_cap: float = 2.0, cpu_budget: float = DEFAULT_CPU_BUDGET,
-                 poll_interval: float = 0.0005,
-                 settle: float = 0.001, max_tick: float = 2.0,
+                 policy: PacingPolicy | None = None, node_name: str = "sim_world",
                  cmd_vel_type: CmdVelType | None = None) -> None:
         self.sim = Simulation(world)
         self.cmd_vel_type: CmdVelType = cmd_vel_type or world.spec.cmd_vel_type
@@ -101,10 +97,8 @@ class SimBridge:
         # Before the node: bad settings (a negative RTF, no clock rate) raise ValueError here.
         # A hold for the student's node ends once our middleware has taken in what it sent.
         self._receiving = Receiving()
-        self.pacer = Pacer(world.dt, real_time_factor, PacingPolicy(
-            clock_hz=max_clock_hz, cpu_budget=cpu_budget, hold_cap=quiescence_cap,
-            settle=settle, poll_interval=poll_interval, max_tick=max_tick),
-            receiving=self._receiving)
+        self.pacer = Pacer(world.dt, real_time_factor, policy, receiving=self._receiving,
+                           delivering=lambda: backlog() > 0)
         self._cond = self.pacer.condition
         self._cmd: tuple[float, float] | None = None
         # Commands taken in a later tick than the one they were sent in, and the most sim
@@ -269,13 +263,14 @@ class SimBridge:
         return self.pacer.real_time_factor
 
     @property
-    def max_clock_hz(self) -> float:
+    def clock_hz(self) -> float:
+        """Most ``/clock`` messages per wall second."""
         return self.pacer.policy.clock_hz
 
     @property
     def pacing(self) -> Counter[HoldOutcome]:
-        """How each tick's hold for the watched processes ended: no process watched
-        ("free"), all idle ("idle"), CPU share used ("budget"), or the wall cap ("cap")."""
+        """How each tick's hold for the watched processes ended (see
+        :data:`sim.pacing.HoldOutcome`)."""
         return self.pacer.counts
 
     @property

@@ -21,7 +21,7 @@ from click.core import ParameterSource
 from content import ContentError
 from content.i18n import _
 from sim.keyboard import Command
-from sim.pacing import DEFAULT_CLOCK_HZ
+from sim.pacing import DEFAULT_CLOCK_HZ, PacingPolicy
 from sim.worldfile import load_world, title_of, world_names, world_path
 
 if TYPE_CHECKING:
@@ -38,8 +38,9 @@ class Companion(Protocol):
     """A program run with the world: started once the world exists, with simulation time
     held until it is up, and stopped before the world."""
 
-    def bridge_options(self) -> dict[str, Any]:
-        """Keyword arguments for :class:`sim.bridge.SimBridge` (``cpu_budget``, ...)."""
+    def pacing_options(self) -> dict[str, Any]:
+        """Fields of the world's :class:`sim.pacing.PacingPolicy` it needs (``cpu_budget``,
+        ...)."""
         ...
 
     def start(self, bridge: SimBridge) -> None:
@@ -152,8 +153,9 @@ def run_world(spec: WorldSpec, *, rtf: float, duration: float | None, domain: in
 
     ctx = Context()
     rclpy.init(context=ctx, domain_id=domain)
-    bridge = SimBridge(World(spec, seed=seed), ctx, real_time_factor=rtf, max_clock_hz=clock_hz,
-                       **(companion.bridge_options() if companion is not None else {}))
+    options = companion.pacing_options() if companion is not None else {}
+    bridge = SimBridge(World(spec, seed=seed), ctx, real_time_factor=rtf,
+                       policy=PacingPolicy(clock_hz=clock_hz, **options))
     recorder = _recorder(bag, bridge, spec.name) if bag else None
     notes: list[str] = []
     warned: set[object] = set()

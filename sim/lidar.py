@@ -1,8 +1,8 @@
 """A 360-beam 2D lidar cast against the world's segments and circles with NumPy.
 
 All beams are intersected with all segments and circles at once (:mod:`sim.raycast`,
-with the geometry prepared once per change): about 25 microseconds a scan in the
-standard world on a 2-core AMD EPYC (``benchmarks/bench_sim.py``).  The scan is cast from
+with the geometry prepared once per change; its cost: ``benchmarks/bench_sim.py``).  The
+scan is cast from
 the scanner's mount point (``base_scan``, by default 3.2 cm behind the robot's centre as
 on a TurtleBot3 Burger), and each reading in range gets Gaussian noise (sigma 0.01 m, as
 TurtleBot3's Gazebo model) drawn from the world's seed and the scan's time: the same

@@ -6,62 +6,34 @@ verdicts would depend on how busy the machine is.  The world advances in *clock 
 long each tick is and when the next one may go.  It reads time only through a
 :class:`Clock` and the student's process only through a
 :data:`~sim.procstate.ProcessReader`, so tests drive it with a fake clock and fake
-processes, in milliseconds.
+processes.  The rules (why each was chosen, and what was measured: the contributors'
+design notes, "Pacing"):
 
-* **Tick length.**  ``/clock`` goes out at most ``clock_hz`` times per *wall* second, 20 by
-  default: Jazzy's MultiThreadedExecutor keeps a 10 Hz sim-time timer exact at 20 Hz but
-  stutters from about 50 Hz (measured; the exercises' ``clock_hz`` has the same default).
-  At a real-time factor ``r > 0`` a tick is the fewest physics steps that make at least
-  ``r / clock_hz`` of sim time (0.05 s at RTF 1), so the cap holds however ``r`` and the
-  step divide.  At ``r == 0`` ("as fast as the graph keeps up") the tick length adapts so
-  that one tick's work fills ``1 / clock_hz`` of wall time, up to ``max_tick`` (2 s): a
-  node then sees its clock jump by up to ``max_tick`` at once, so graders who care about
-  timer granularity pick a finite RTF.
-* **Wall deadline.**  A tick is given ``steps * dt / r`` wall seconds (``1 / clock_hz`` at
-  RTF 0).  There is no catch-up: a late tick moves the schedule, so sim time just runs
-  slower; it never bursts to make up for a stall or a hold.
-* **Hold for the student.**  With watched processes, the next tick also waits until none
-  of them is running or runnable, or each busy one has used ``cpu_budget`` (50 ms) of CPU
-  since the tick, with ``hold_cap`` (2 s) of wall time as the last resort.  A process that
-  cannot get a CPU on a busy machine thus holds sim time back however long it waits, while
-  one that busy-loops has had its share after 50 ms of CPU and only slows the world.  (A
-  wall-time cap alone, tried first, let sim time run on while a starved process waited
-  for a CPU, and a correct node then failed under load.)  How each hold ended is counted
-  (:attr:`Pacer.counts`; the results file's ``pacing``).
-* **CPU reserve.**  A process that is usually idle may take a longer turn now and then:
-  each watched process banks, up to ``cpu_reserve`` (2 s), the part of ``cpu_budget`` it
-  leaves unused in each tick, and a tick's hold draws on that bank once the budget is
-  used.  It starts empty, so a process that computes from the start never has one.
-  Jazzy's MultiThreadedExecutor (rclpy 7.1.6, the PyPI wheel; rclpy issue 1452) loops on
-  a ready callback, handing it to its thread pool again, until a worker starts it: on a
-  loaded machine a correct node's main thread burnt 220-240 ms of CPU in one tick while
-  timer_sync's planner slept.  A budget alone then let the tick go on without it (seen in
-  CI: eight gradings on two cores, a beat lost).  A process that always computes gets
-  exactly ``cpu_budget`` a tick, so a busy loop slows the world no more than before.
-  Holds that drew on the reserve are counted (:attr:`Pacer.bursts`).
-* **Heard first.**  Idle only counts once the process has *heard* the tick: its CPU time
-  has grown since just before the tick went out (:meth:`Pacer.about_to_publish`), or it
-  is running.  On a loaded machine the kernel may hand a loopback datagram to the
-  student's socket late (receive work deferred to ``ksoftirqd``); a process read as idle
-  meanwhile has not started on the tick, and the next tick would overtake it (a 10 Hz
-  timer then skips a beat: seen in CI, eight gradings on two cores).  The hold waits up
-  to ``hear_timeout`` (0.5 s) for it, if it heard the tick before: whether it did is
-  judged over the whole time between the two ticks.  A process that hears no ticks (no
-  ``/clock`` subscription, or hung before making its node) thus costs one
-  ``hear_timeout``, not one per tick.  Ticks held this way are counted
-  (:attr:`Pacer.late_deliveries`: those the pacing would otherwise have let go early).
-* **Taken in.**  Then the world's own middleware must have taken in what the processes
-  sent: a tick goes only once the world's receive threads are idle and the kernel holds no
-  received packets (:class:`sim.procstate.Receiving`), for up to ``receive_timeout``
-  (0.5 s).  A node idle after publishing its command has sent it, but on a loaded machine
-  the grader's own receive thread may wait for a CPU meanwhile: with eight error_handling
-  gradings on two cores, 1.5% of a correct node's commands were taken one to three ticks
-  late without this wait (4.5% when an executor thread took them, and one of 100 such
-  gradings lost a test).  Holds that waited for this are counted
-  (:attr:`Pacer.receipts_awaited`).
+* **Tick length.**  At most ``clock_hz`` ticks per wall second (Jazzy's
+  MultiThreadedExecutor keeps a sim-time timer exact at 20 Hz, not at 50).  At a real-time
+  factor ``r > 0`` a tick is the fewest physics steps that make ``r / clock_hz`` of sim
+  time; at ``r == 0`` its length adapts so that its work fills ``1 / clock_hz`` of wall
+  time, up to ``max_tick``.
+* **Wall deadline.**  A tick is given ``steps * dt / r`` wall seconds; a late tick moves
+  the schedule (no catch-up burst), so sim time just runs slower.
+* **Hold.**  With watched processes, the next tick also waits until each has *heard* the
+  tick and is idle (two readings agreeing: one reading is thread after thread, not an
+  instant), or has used its CPU share since the tick (``cpu_budget`` and what it banked
+  in its reserve), so a process that waits for a CPU holds sim time back and one that
+  busy-loops only slows it.  A process hears a tick when its CPU time grows or it
+  runs after the tick went out; one that heard the tick before is waited for to hear this
+  one, up to ``hear_timeout`` while the kernel holds no packet it has not yet delivered.
+  Then the world's own middleware must have taken in what the processes sent, up to
+  ``receive_timeout``.  ``hold_cap`` ends a hold, not counting the time in which every busy
+  watched process waited for a CPU; ``hold_limit`` ends it whatever the machine.
+* **CPU reserve.**  Each watched process banks, up to ``cpu_reserve``, the part of
+  ``cpu_budget`` it leaves unused in each tick, and a hold draws on that bank once the
+  budget is used: a usually idle node may take a longer turn now and then (an executor
+  catching up), while a busy loop banks nothing.
 * **Held.**  Inside :meth:`Pacer.held` (a student's program starting) no tick goes;
   afterwards the schedule starts afresh from that moment.
 
+How each hold ended is counted (:attr:`Pacer.counts`: the results file's ``pacing``).
 The pacer's condition is the bridge's lock: a tick runs under it, so ``pause()`` returning
 means no tick starts afterwards, and waiters for sim time are woken on it.
 """
@@ -74,19 +46,19 @@ import math
 import threading
 import time
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Literal, Protocol
 
 from sim.procstate import ProcessReader, ProcessState, read_process_state
 
 DEFAULT_CLOCK_HZ = 20.0
-"""Most ``/clock`` messages per wall second; see the module's docstring for why 20."""
+"""Most ``/clock`` messages per wall second: a 10 Hz sim-time timer stays exact."""
 DEFAULT_CPU_BUDGET = 0.05
 """CPU seconds a busy student process gets after a tick before the world goes on."""
 
 HoldOutcome = Literal["free", "idle", "budget", "unheard", "cap"]
 """How a tick's hold ended: nothing watched, all idle, CPU share used, a process that did
-not hear the tick within ``hear_timeout``, or the wall cap."""
+not hear the tick within ``hear_timeout``, or ``hold_cap``/``hold_limit``."""
 
 
 class Clock(Protocol):
@@ -126,24 +98,24 @@ class PacingPolicy:
     clock_hz: float = DEFAULT_CLOCK_HZ
     cpu_budget: float = DEFAULT_CPU_BUDGET
     hold_cap: float = 2.0
-    """Longest hold for a watched process, from the tick's publication."""
+    """Longest hold for watched processes, from the tick's publication, not counting the
+    time in which every busy one waited for a CPU (the machine's doing, not theirs)."""
+    hold_limit: float = 10.0
+    """Longest hold in wall time, however long the processes waited for a CPU."""
     settle: float = 0.001
     """Pause after publishing before the first look at the processes: a reading taken at
     once would often find them idle only because the messages had not reached them."""
     hear_timeout: float = 0.5
-    """Longest wait, from the tick's publication, for a watched process to hear it."""
+    """Longest wait, from the tick's publication, for a watched process to hear it, while
+    the kernel holds no packet it has not yet delivered."""
     cpu_reserve: float = 2.0
     """Most CPU seconds a watched process may bank, beyond ``cpu_budget``, for a burst."""
     poll_interval: float = 0.0005
-    """Pause between two readings of the watched processes while holding a tick (a
-    reading of a 16-thread rclpy process takes about 0.22 ms more).  Cheaper looks once
-    let Jazzy's MultiThreadedExecutor spin past its share, until students' programs got a
-    shorter GIL switch interval (:mod:`autograder.sandbox.runner`; README, "Pacing")."""
+    """Pause between two readings of the watched processes while holding a tick: short,
+    so that a node's executor is not left spinning past its share between two looks."""
     starved_poll_max: float = 0.004
     """Longest pause between two readings while every busy watched process waits for a
-    CPU (its CPU time did not grow since the reading before): the pause doubles from
-    ``poll_interval`` up to this, so that on a machine short of CPU the world's readings
-    leave the cores to the processes it waits for."""
+    CPU: the pause doubles from ``poll_interval`` up to this, leaving the cores to them."""
     max_tick: float = 2.0
     """Longest tick at RTF 0, in sim seconds."""
     receive_timeout: float = 0.5
@@ -179,6 +151,7 @@ class Pacer:
                  policy: PacingPolicy | None = None, *, clock: Clock | None = None,
                  read_process: ProcessReader = read_process_state,
                  receiving: Callable[[], bool] | None = None,
+                 delivering: Callable[[], bool] | None = None,
                  condition: threading.Condition | None = None) -> None:
         if real_time_factor < 0:
             raise ValueError("real_time_factor must be >= 0")
@@ -189,6 +162,9 @@ class Pacer:
         self._read = read_process
         # True while the world's middleware still takes messages in (None: never waited for).
         self._receiving = receiving
+        # True while the kernel holds received packets no socket has been handed yet: a
+        # tick may still be on its way to a process (None: never).
+        self._delivering = delivering
         self._rtf = real_time_factor
         self._adaptive_tick = 1.0 / self.policy.clock_hz
         self._running = True
@@ -380,82 +356,148 @@ class Pacer:
 
     def _hold(self, published: float, deadline: float) -> None:
         """Hold until every watched process has heard the tick and is idle or has had its
-        CPU share, or the cap.
-
-        A process that keeps computing is let go once it has used ``cpu_budget`` seconds of
-        CPU since the tick and whatever it has in reserve (it is busy, not slow); one that
-        is runnable but gets no CPU (a busy machine) holds the world back, up to
-        ``hold_cap`` of wall time; one that is idle but has not heard the tick is waited for
-        up to ``hear_timeout``.  Then, up to ``receive_timeout``, the world's middleware
-        must have taken in what they sent.
-        """
-        with self.condition:
-            pids = tuple(self._pids)
-            before, listening = dict(self._before), set(self._listening)
-            reserve = {pid: self._reserve.get(pid, 0.0) for pid in pids}
-        if not pids:
+        CPU share, then until the world has taken in what they sent (see the module's
+        docstring), and count how the hold ended."""
+        hold = self._begin_hold(published, deadline)
+        if hold is None:
             self.counts["free"] += 1
             return
-        clock, policy = self._clock, self.policy
+        outcome = self._poll(hold)
+        self._account(hold, outcome, deadline)
+
+    def _begin_hold(self, published: float, deadline: float) -> _Hold | None:
+        """The watched processes as the tick went out (None: none watched), after
+        ``settle``."""
+        with self.condition:
+            pids = tuple(self._pids)
+            before, listening = dict(self._before), frozenset(self._listening)
+            reserve = {pid: self._reserve.get(pid, 0.0) for pid in pids}
+        if not pids:
+            return None
+        policy = self.policy
         first = min(published + policy.settle, deadline)
-        now = clock.monotonic()
+        now = self._clock.monotonic()
         if now < first:
-            clock.sleep(first - now)
+            self._clock.sleep(first - now)
         # Without a reading from before the tick (a process watched since), the budget
         # counts from now and the process counts as having heard the tick.
         baseline = {pid: before[pid] if pid in before else self._read(pid).cpu_ns
                     for pid in pids}
-        heard = {pid: pid not in before for pid in pids}
         budget_ns = int(policy.cpu_budget * 1e9)
-        share_ns = {pid: budget_ns + int(reserve[pid] * 1e9) for pid in pids}
-        cap = published + policy.hold_cap
-        deafness = published + policy.hear_timeout
-        outcome: HoldOutcome = "cap"
-        late = False
-        receipt_cap: float | None = None  # set once the processes are done
-        awaited = False
-        states: dict[int, ProcessState] = {}
-        pause = policy.poll_interval
-        while (now := clock.monotonic()) < cap:
-            previous, states = states, {pid: self._read(pid) for pid in pids}
-            pause = (min(2 * pause, policy.starved_poll_max)
-                     if _starved(previous, states) else policy.poll_interval)
-            for pid, state in states.items():
-                heard[pid] = heard[pid] or (not state.exists or state.busy
-                                            or state.cpu_ns > baseline[pid])
-            working = any(state.busy and state.cpu_ns - baseline[pid] < share_ns[pid]
-                          for pid, state in states.items())
-            waiting = [pid for pid in listening if pid in heard and not heard[pid]]
-            if not working and waiting and now >= deafness:
-                outcome = "unheard"
-                break
-            if not working and not waiting:
-                if receipt_cap is None:
-                    receipt_cap = now + policy.receive_timeout
-                if self._receiving is None or now >= receipt_cap or not self._receiving():
-                    outcome = "budget" if any(s.busy for s in states.values()) else "idle"
-                    break
-                awaited = True
+        return _Hold(published=published, baseline=baseline, reserve=reserve,
+                     share_ns={pid: budget_ns + int(reserve[pid] * 1e9) for pid in pids},
+                     heard={pid: pid not in before for pid in pids}, listening=listening,
+                     cap=published + policy.hold_cap)
+
+    def _poll(self, hold: _Hold) -> HoldOutcome:
+        """Read the watched processes until the hold may end; how it ended."""
+        clock, policy = self._clock, self.policy
+        limit = hold.published + policy.hold_limit
+        deafness = hold.published + policy.hear_timeout
+        receipt_due: float | None = None  # set once the processes are done
+        pause, then = policy.poll_interval, clock.monotonic()
+        while (now := clock.monotonic()) < min(hold.cap, limit):
+            if hold.read({pid: self._read(pid) for pid in hold.baseline}):
+                hold.cap += now - then  # they all waited for a CPU since the last look
+                pause = min(2 * pause, policy.starved_poll_max)
             else:
-                late = late or not working
+                pause = policy.poll_interval
+            then = now
+            if hold.working:
+                pass  # its share, or hold_cap, ends this
+            elif not hold.still:
+                pass  # one reading showed them done: a second must agree
+            elif hold.deaf:
+                if now >= deafness and not self._in_flight():
+                    return "unheard"
+                hold.late = True
+            else:
+                if receipt_due is None:
+                    receipt_due = now + policy.receive_timeout
+                if self._receiving is None or now >= receipt_due or not self._receiving():
+                    return "budget" if hold.busy else "idle"
+                hold.awaited = True
             clock.sleep(pause)
-        self.receipts_awaited += awaited
+        return "cap"
+
+    def _in_flight(self) -> bool:
+        return self._delivering is not None and self._delivering()
+
+    def _account(self, hold: _Hold, outcome: HoldOutcome, deadline: float) -> None:
+        """Bank what each process left of its budget, and count the hold."""
+        budget_ns = int(self.policy.cpu_budget * 1e9)
         burst = False
         with self.condition:
-            self._heard = {pid for pid, yes in heard.items() if yes}
-            for pid, state in states.items():
-                used_ns = max(0, state.cpu_ns - baseline[pid])
-                burst = burst or (used_ns > budget_ns and reserve[pid] > 0)
+            self._heard = {pid for pid, yes in hold.heard.items() if yes}
+            for pid, used_ns in hold.used_ns().items():
+                burst = burst or (used_ns > budget_ns and hold.reserve[pid] > 0)
                 if pid in self._reserve:  # not unwatched meanwhile
-                    self._reserve[pid] = min(policy.cpu_reserve, max(
-                        0.0, reserve[pid] + (budget_ns - used_ns) / 1e9))
+                    self._reserve[pid] = min(self.policy.cpu_reserve, max(
+                        0.0, hold.reserve[pid] + (budget_ns - used_ns) / 1e9))
         self.bursts += burst
+        self.receipts_awaited += hold.awaited
         self.counts[outcome] += 1
-        if late and outcome != "unheard":
+        if hold.late and outcome != "unheard":
             self.late_deliveries += 1
-        ended = clock.monotonic()
-        self.longest_hold = max(self.longest_hold, ended - published)
-        self.held_seconds += max(0.0, ended - max(deadline, published))
+        ended = self._clock.monotonic()
+        self.longest_hold = max(self.longest_hold, ended - hold.published)
+        self.held_seconds += max(0.0, ended - max(deadline, hold.published))
+
+
+@dataclass
+class _Hold:
+    """One tick's hold: what the watched processes had when it went out, what each may
+    use, and what the readings since showed (:meth:`Pacer._poll` fills it in)."""
+
+    published: float
+    baseline: dict[int, int]  # CPU ns of each process when the tick went out
+    reserve: dict[int, float]  # CPU seconds each had banked
+    share_ns: dict[int, int]  # CPU ns each may use before the tick goes on without it
+    heard: dict[int, bool]  # whether each has heard the tick
+    listening: frozenset[int]  # those that heard the tick before: waited for to hear it
+    cap: float  # when hold_cap ends the hold (pushed back while they wait for a CPU)
+    states: dict[int, ProcessState] = field(default_factory=dict)  # the last reading
+    late: bool = False  # an idle process had not heard the tick yet
+    awaited: bool = False  # the world's middleware was still taking messages in
+    still: bool = False  # the last two readings agree that none of them works
+
+    def read(self, states: dict[int, ProcessState]) -> bool:
+        """Take a reading; True if every busy process waited for a CPU since the last."""
+        previous, self.states = self.states, states
+        for pid, state in states.items():
+            self.heard[pid] = self.heard[pid] or (not state.exists or state.busy
+                                                  or state.cpu_ns > self.baseline[pid])
+        # A reading of a process is one thread after another, not one instant: a thread
+        # woken by another after we read it, the other gone to sleep before we read it,
+        # reads idle.  It will have run, or be runnable, by the next reading.
+        self.still = all(not state.exists or self._spent(pid) or (
+            pid in previous and not previous[pid].busy and not state.busy
+            and previous[pid].cpu_ns == state.cpu_ns) for pid, state in states.items())
+        return _starved(previous, states)
+
+    def _spent(self, pid: int) -> bool:
+        """Process ``pid`` has used its share since the tick (it is let go, busy or not)."""
+        return self.states[pid].cpu_ns - self.baseline[pid] >= self.share_ns[pid]
+
+    @property
+    def working(self) -> bool:
+        """Some process is busy and has not used its share."""
+        return any(state.busy and state.cpu_ns - self.baseline[pid] < self.share_ns[pid]
+                   for pid, state in self.states.items())
+
+    @property
+    def busy(self) -> bool:
+        return any(state.busy for state in self.states.values())
+
+    @property
+    def deaf(self) -> bool:
+        """Some process that heard the tick before has not heard this one yet."""
+        return any(not self.heard[pid] for pid in self.listening if pid in self.heard)
+
+    def used_ns(self) -> dict[int, int]:
+        """CPU ns each process used since the tick, as last read."""
+        return {pid: max(0, state.cpu_ns - self.baseline[pid])
+                for pid, state in self.states.items()}
 
 
 def _starved(before: dict[int, ProcessState], now: dict[int, ProcessState]) -> bool:

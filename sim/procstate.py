@@ -48,7 +48,7 @@ def _thread_running(stat: bytes) -> bool:
 
 
 # Each watched thread's ``stat`` and ``schedstat``, kept open and read with ``pread``: the
-# pacing reads a busy process every 0.5 ms, and opening two files per thread each time was
+# pacing reads a busy process every 0.5 ms, and opening two files per thread each time is
 # most of the kernel's share of the world's CPU (``benchmarks/RESULTS.md``). pid -> tid ->
 # (stat, schedstat); the processes read least recently are closed past MAX_PROCESSES.
 _open: dict[int, dict[str, tuple[int, int]]] = {}

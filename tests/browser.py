@@ -9,7 +9,6 @@ from __future__ import annotations
 import base64
 import contextlib
 import shutil
-import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -42,23 +41,46 @@ def skip_without_browser() -> str:
     return path
 
 
+class _Shared:
+    """One headless Chromium for the whole test session, started at the first page:
+    starting a browser costs more than most of the tests that use it. Each page gets a
+    context of its own (its own storage, cookies and cache), as a fresh profile would."""
+
+    playwright: Any = None
+    browser: Any = None
+
+
+def _browser(executable: str) -> Any:
+    if _Shared.browser is None:
+        from playwright.sync_api import sync_playwright
+
+        _Shared.playwright = sync_playwright().start()
+        _Shared.browser = _Shared.playwright.chromium.launch(
+            executable_path=executable, headless=True, args=CHROMIUM_FLAGS)
+    return _Shared.browser
+
+
+def close_browser() -> None:
+    """End the session's Chromium, if one was started (tests/conftest.py, at the end)."""
+    if _Shared.playwright is not None:
+        try:
+            _Shared.browser.close()
+        finally:
+            _Shared.playwright.stop()
+            _Shared.playwright = _Shared.browser = None
+
+
 @contextlib.contextmanager
 def chromium_page(width: int = 900, height: int = 1200) -> Iterator[Any]:
-    """A page in a fresh headless Chromium profile, closed afterwards."""
-    executable = skip_without_browser()
-    from playwright.sync_api import sync_playwright
-
-    with tempfile.TemporaryDirectory(prefix="chromium-profile-") as profile, \
-            sync_playwright() as p:
-        context = p.chromium.launch_persistent_context(
-            profile, executable_path=executable, headless=True, args=CHROMIUM_FLAGS,
-            viewport={"width": width, "height": height}, locale="ur-PK")
-        try:
-            page = context.pages[0] if context.pages else context.new_page()
-            page.set_default_timeout(15_000)
-            yield page
-        finally:
-            context.close()
+    """A page in a fresh context of the session's headless Chromium, closed afterwards."""
+    context = _browser(skip_without_browser()).new_context(
+        viewport={"width": width, "height": height}, locale="ur-PK")
+    try:
+        page = context.new_page()
+        page.set_default_timeout(15_000)
+        yield page
+    finally:
+        context.close()
 
 
 _INK_JS = """

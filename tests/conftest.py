@@ -4,11 +4,13 @@ from __future__ import annotations
 
 import contextlib
 import os
+import sys
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 import pytest
 from proving import STANDARD_CHECKS, Proof
+from student_runs import StudentRuns
 
 from autograder.core.results import RunResult
 from autograder.sandbox.domains import reserve_domain
@@ -23,6 +25,15 @@ def ros_domain() -> Iterator[int]:
     os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
     with reserve_domain() as domain:
         yield domain
+
+
+@pytest.fixture(scope="session")
+def student_runs(tmp_path_factory: pytest.TempPathFactory) -> Iterator[StudentRuns]:
+    """``check`` and ``grade`` as a student runs them, each once for every module that
+    reads it (tests/student_runs.py)."""
+    runs = StudentRuns(tmp_path_factory.mktemp("student-runs"))
+    yield runs
+    runs.close()
 
 
 @contextlib.contextmanager
@@ -77,3 +88,10 @@ def proof(request: pytest.FixtureRequest) -> Proof:
 def graded(proof: Proof, tmp_path_factory: pytest.TempPathFactory) -> dict[str, RunResult]:
     """Every submission of the module's PROOF, graded once for all its checks."""
     return proof.grade_all(tmp_path_factory.mktemp("submissions"))
+
+
+def pytest_sessionfinish(session: pytest.Session) -> None:
+    """Close the Chromium that the browser tests share (tests/browser.py), if they ran."""
+    browser = sys.modules.get("browser")
+    if browser is not None:
+        browser.close_browser()

@@ -81,6 +81,17 @@ def _difference(result: RunResult | BaseException, variant: Variant) -> str | No
     return "; ".join(parts) or None
 
 
+def _paced(result: RunResult) -> str:
+    """How the world held its ticks in each module, where it was not simply for an idle
+    node: which way a lost test's sim time may have run ahead of the node."""
+    notable = ("budget", "unheard", "cap", "late_deliveries", "bursts", "late_commands",
+               "longest_hold")
+    return "; ".join(
+        f"{module}: " + ", ".join(f"{key}={counts[key]}" for key in notable
+                                  if counts.get(key))
+        for module, counts in sorted(result.pacing.items()))
+
+
 def _round(chosen: list[tuple[str, Variant]], workdir: Path,
            jobs: int) -> list[RunResult | BaseException]:
     with ThreadPoolExecutor(max_workers=jobs) as pool:
@@ -122,7 +133,7 @@ def main(argv: list[str]) -> int:
                         said = "" if isinstance(result, BaseException) else \
                             f"score {result.score}/{result.max_score}: "
                         told = "" if isinstance(result, BaseException) else \
-                            f"\n      said: {failures(result)}"
+                            f"\n      said: {failures(result)}\n      paced: {_paced(result)}"
                         differences.setdefault(key, []).append(
                             f"round {round_}: {said}{difference}{told}")
                 print(f"round {round_} done, {time.monotonic() - started:.0f} s",

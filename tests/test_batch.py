@@ -13,6 +13,7 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from types import SimpleNamespace
 
 import pytest
 
@@ -63,14 +64,19 @@ def submissions(tmp_path_factory, course_env) -> Path:
 
 
 @pytest.fixture(scope="module")
-def one_by_one(submissions) -> dict[str, str]:
+def one_by_one(tmp_path_factory, course_env) -> dict[str, str]:
+    """Each student's score graded alone: each of the five programs graded once, alone (a
+    student's score is its program's; the class holds each program two or more times)."""
     exercise = find_exercise("shout")
-    scores = {}
-    for entry in sorted(submissions.iterdir()):
-        result = grade(exercise, entry)
+    folder = tmp_path_factory.mktemp("one-by-one")
+    by_kind = {}
+    for kind in sorted(set(KINDS)):
+        (folder / kind).mkdir()
+        (folder / kind / "shouter.py").write_text(VARIANTS[kind])
+        result = grade(exercise, folder / kind)
         assert result.grader_error is None, result.grader_details
-        scores[entry.stem] = str(result.score)
-    return scores
+        by_kind[kind] = str(result.score)
+    return {f"student{i:02d}": by_kind[kind] for i, kind in enumerate(KINDS)}
 
 
 def batch(args: list[str], env: dict[str, str], **kwargs) -> subprocess.Popen:
@@ -89,22 +95,6 @@ EXPECTED = {"good": "3", "lower": "2", "double": "2", "syntax": "0", "crash": "0
 
 def test_one_by_one_scores_good_bad_and_broken(one_by_one):
     assert one_by_one == {f"student{i:02d}": EXPECTED[kind] for i, kind in enumerate(KINDS)}
-
-
-def test_batch_with_two_jobs_matches_one_by_one(tmp_path, submissions, one_by_one, course_env):
-    book, out = tmp_path / "gradebook.csv", tmp_path / "reports"
-    proc = batch(["shout", str(submissions), "--jobs", "2", "--csv", str(book),
-                  "--out", str(out)], course_env)
-    output, _ = proc.communicate(timeout=600)
-    assert proc.returncode == 0, output
-    graded = rows(book)
-    assert {s: r["score"] for s, r in graded.items()} == one_by_one
-    assert all(r["max_score"] == "3" for r in graded.values())
-    assert {r["passed"] for r in graded.values()} == {"yes", "no"}
-    assert "shout:test_upper_case" in next(iter(graded.values()))
-    assert (out / "student00" / "report.html").exists()
-    assert (out / "student00" / "gradescope.json").exists()
-    assert "RuntimeError: boom" in (out / "student04" / "output.log").read_text()  # crash
 
 
 def test_batch_at_auto_matches_one_by_one(tmp_path, submissions, one_by_one, course_env):
@@ -174,9 +164,13 @@ def alive(processes: set[tuple[int, str]]) -> set[tuple[int, str]]:
     return {(p, t) for p, t in processes if p in table and table[p][1] == t}
 
 
-def test_batch_resumes_after_being_killed(tmp_path, submissions, one_by_one, course_env):
-    """Killed with SIGKILL, the batch leaves no grading running (each run's child sees
-    its lifeline close and ends itself and its student processes)."""
+@pytest.fixture(scope="module")
+def resumed(tmp_path_factory, submissions, course_env) -> SimpleNamespace:
+    """The class graded two at a time, killed with SIGKILL part-way, then run again: the
+    second run's output, the gradebook and the reports, and who was graded before the
+    kill. Killed, the batch leaves no grading running (each run's child sees its
+    lifeline close and ends itself and its student processes)."""
+    tmp_path = tmp_path_factory.mktemp("resumed")
     book, out = tmp_path / "gradebook.csv", tmp_path / "reports"
     args = ["shout", str(submissions), "--jobs", "2", "--csv", str(book), "--out", str(out)]
     first = batch(args, course_env)
@@ -217,9 +211,28 @@ def test_batch_resumes_after_being_killed(tmp_path, submissions, one_by_one, cou
     second = batch(args, course_env)
     output, _ = second.communicate(timeout=600)
     assert second.returncode == 0, output
-    for student in done_before:
-        assert f"{student}: already graded" in output
-    assert {s: r["score"] for s, r in rows(book).items()} == one_by_one
+    return SimpleNamespace(output=output, book=book, out=out, done_before=done_before)
+
+
+def test_batch_resumes_after_being_killed(resumed, one_by_one):
+    for student in resumed.done_before:
+        assert f"{student}: already graded" in resumed.output
+    assert {s: r["score"] for s, r in rows(resumed.book).items()} == one_by_one
+
+
+def test_batch_with_two_jobs_matches_one_by_one(resumed, one_by_one):
+    """The gradebook and reports of the class graded two at a time (the resumed batch's:
+    what a killed and resumed batch writes is what one run writes)."""
+    graded = rows(resumed.book)
+    assert {s: r["score"] for s, r in graded.items()} == one_by_one
+    assert all(r["max_score"] == "3" for r in graded.values())
+    assert {r["passed"] for r in graded.values()} == {"yes", "no"}
+    assert "shout:test_upper_case" in next(iter(graded.values()))
+    assert (resumed.out / "student00" / "report.html").exists()
+    assert (resumed.out / "student00" / "gradescope.json").exists()
+    assert "RuntimeError: boom" in (resumed.out / "student04" / "output.log").read_text()
+
+
 
 
 def test_shards_partition_and_merge(tmp_path, submissions, one_by_one, course_env):

@@ -1,5 +1,6 @@
 """What a student reads after ``check`` and ``grade``: the real output of the command, in
-English and Urdu, on parameter_validation's starter and reference.
+English and Urdu, on parameter_validation's starter and reference (runs shared with the
+other modules that read them: tests/student_runs.py).
 
 Each test's line appears once, each failure's message once and each hint once (failures
 that share one stand together under it), the student's file is named as they gave it
@@ -11,7 +12,6 @@ its own, grading in the simulator), two at a time, as the exercises' proofs run.
 
 from __future__ import annotations
 
-import json
 import os
 import pty
 import re
@@ -19,13 +19,13 @@ import subprocess
 import sys
 import unicodedata
 from collections import Counter
-from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from types import SimpleNamespace
 from typing import Any
 
 import pytest
 from babel.numbers import format_percent
+from student_runs import TEST_LINE, Run, Spec, StudentRuns, env
 
 from autograder.i18n import translations
 
@@ -35,31 +35,13 @@ REPO = Path(__file__).resolve().parent.parent
 EXERCISE = "parameter_validation"
 STARTER = f"assignments/{EXERCISE}/starter/velocity_governor.py"
 REFERENCE = f"assignments/{EXERCISE}/solution"
-RLM = "\u200f"
-TEST_LINE = re.compile(r"^ [✔✘!-] +[\d.]+/[\d.]+  (.*)$")
-# command, submission, language
 RUNS = {
-    "check-starter-en": ("check", STARTER, "en"),
-    "check-starter-ur": ("check", STARTER, "ur"),
-    "check-reference-en": ("check", REFERENCE, "en"),
-    "grade-starter-en": ("grade", STARTER, "en"),
-    "grade-reference-ur": ("grade", REFERENCE, "ur"),
+    "check-starter-en": Spec("check", EXERCISE, STARTER, "en"),
+    "check-starter-ur": Spec("check", EXERCISE, STARTER, "ur"),
+    "check-reference-en": Spec("check", EXERCISE, REFERENCE, "en"),
+    "grade-starter-en": Spec("grade", EXERCISE, STARTER, "en"),
+    "grade-reference-ur": Spec("grade", EXERCISE, REFERENCE, "ur"),
 }
-
-
-class Run:
-    """One command's output (stdout, as a pipe gets it) and its results file."""
-
-    def __init__(self, stdout: str, stderr: str, code: int, results: dict[str, Any]) -> None:
-        self.stdout, self.stderr, self.code, self.results = stdout, stderr, code, results
-        # The terminal's bidi marks (a line's RLM, code's isolates) are not text.
-        self.lines = [_unmarked(line).removeprefix(RLM) for line in stdout.splitlines()]
-
-    def test_lines(self) -> Counter[str]:
-        return Counter(m[1] for m in map(TEST_LINE.match, self.lines) if m)
-
-    def count(self, text: str) -> int:
-        return _unmarked(self.stdout).replace(RLM, "").count(text)
 
 
 def _marked(test: dict, lang: str) -> str:
@@ -71,32 +53,12 @@ def _marked(test: dict, lang: str) -> str:
         return core_label(SimpleNamespace(label=test["label"], core=test["core"]))
 
 
-def _unmarked(text: str) -> str:
-    return text.replace("\u2066", "").replace("\u2069", "")
-
-
-def _env() -> dict[str, str]:
-    env = {k: v for k, v in os.environ.items() if k not in ("NO_COLOR", "AUTOGRADER_LANG")}
-    return {**env, "PYTHONPATH": str(REPO), "TERM": "xterm-256color"}
-
-
-def _run(name: str, tmp: Path) -> Run:
-    command, submission, lang = RUNS[name]
-    results = tmp / f"{name}.json"
-    done = subprocess.run(
-        [sys.executable, "-m", "autograder.cli", command, EXERCISE, submission, "--lang", lang,
-         "--results", str(results)], cwd=REPO, env=_env(), capture_output=True, text=True,
-        timeout=600)
-    data = json.loads(results.read_text()) if results.exists() else {}
-    return Run(done.stdout, done.stderr, done.returncode, data)
-
-
-def _run_on_a_terminal(tmp: Path) -> str:
+def _run_on_a_terminal() -> str:
     """``check`` on the starter with its stdout on a pseudo-terminal: the raw text."""
     leader, follower = pty.openpty()
     process = subprocess.Popen(
         [sys.executable, "-m", "autograder.cli", "check", EXERCISE, STARTER, "--lang", "en"],
-        cwd=REPO, env={**_env(), "COLUMNS": "200"}, stdout=follower,
+        cwd=REPO, env={**env(), "COLUMNS": "200"}, stdout=follower,
         stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL)
     os.close(follower)
     chunks = []
@@ -114,13 +76,10 @@ def _run_on_a_terminal(tmp: Path) -> str:
 
 
 @pytest.fixture(scope="module")
-def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
-    tmp = tmp_path_factory.mktemp("cli-output")
-    with ThreadPoolExecutor(max_workers=2) as pool:
-        futures = {name: pool.submit(_run, name, tmp) for name in RUNS}
-        on_terminal = pool.submit(_run_on_a_terminal, tmp)
-        return {"terminal": on_terminal.result(),
-                **{name: future.result() for name, future in futures.items()}}
+def runs(student_runs: StudentRuns) -> dict[str, Any]:
+    on_terminal = student_runs.submit("check-starter-en-on-a-terminal", _run_on_a_terminal)
+    made = dict(zip(RUNS, student_runs.get(*RUNS.values()), strict=True))
+    return {**made, "terminal": on_terminal.result()}
 
 
 @pytest.mark.parametrize("name", list(RUNS))

@@ -72,14 +72,35 @@ def test_backing_into_a_box_behind_gets_no_note():
 
 
 def test_grazing_a_wall_at_a_slant_gets_no_note():
+    """A touch 40 degrees off the heading is outside the ±30 degree front sector the
+    READMEs teach: a node that watched it would not have seen the wall there."""
     world = World(load_world("empty_room"))
-    world.robot.angle = world.control.angle = math.radians(60)  # toward the top wall
+    world.robot.angle = world.control.angle = math.radians(50)  # toward the top wall
     sim = drive(world, 0.3)
     samples, contacts = sim.recording.snapshot()
     assert contacts[0].what.startswith("wall")
     assert bearing(contacts[0], samples, world.geometry) == pytest.approx(
-        math.radians(30), abs=math.radians(2))
+        math.radians(40), abs=math.radians(2))
     assert front_beam_note(contacts, samples, world.geometry) == ""
+
+
+@pytest.mark.parametrize("start,turn,expected", [(14, 0.0, 14), (10, -0.175, 25)],
+                         ids=["straight", "turning"])
+def test_driving_into_a_wall_inside_the_front_sector_gets_the_note(start, turn, expected):
+    """ai_bridge's corridor, as gap_follower_middle_beam meets it: the robot drives back
+    west into the end wall, turning, and touches it some 25 degrees off the heading it has
+    at that moment (14 when it goes straight): inside the front sector, so the note comes
+    (issue 30)."""
+    world = World(load_world("corridor"))
+    world.robot.position = world.control.position = (0.6, 1.0)
+    world.robot.angle = world.control.angle = math.radians(180 - start)
+    sim = drive(world, 0.35, turn)
+    samples, contacts = sim.recording.snapshot()
+    assert contacts[0].what == "wall 3"  # the room's west wall, the corridor's end
+    assert math.degrees(abs(bearing(contacts[0], samples, world.geometry))) == \
+        pytest.approx(expected, abs=1)
+    assert front_beam_note(contacts, samples, world.geometry).startswith(
+        "The robot drove into wall 3 straight ahead.")
 
 
 def test_a_hit_outside_the_nodes_run_gets_no_note():

@@ -145,9 +145,23 @@ def left_behind(work: Work) -> tuple[list[tuple[int, str]], list[str]]:
     return working_in(work.tmp), folders
 
 
+def described(pid: int) -> str:
+    """A left process, as a failure should name it: its user, parent and command."""
+    try:
+        status = dict(line.split(":\t", 1) for line in
+                      Path(f"/proc/{pid}/status").read_text().splitlines() if ":\t" in line)
+        command = Path(f"/proc/{pid}/cmdline").read_bytes().replace(b"\0", b" ")
+    except OSError:
+        return f"{pid} (gone)"
+    return (f"{pid} uid {status.get('Uid', '?').split()[0]} parent {status.get('PPid')}: "
+            f"{command[:200].decode(errors='replace')}")
+
+
 def assert_nothing_left(work: Work, output: str) -> None:
     wait_for(lambda: left_behind(work) == ([], []), 15, None)
-    assert left_behind(work) == ([], []), output
+    processes, folders = left_behind(work)
+    assert (processes, folders) == ([], []), (
+        output + "\n".join(described(pid) for pid, _cwd in processes))
 
 
 def started(case: Case, work: Work, **popen: object) -> subprocess.Popen[bytes]:

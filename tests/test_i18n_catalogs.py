@@ -201,3 +201,23 @@ def test_no_entry_reads_as_a_percent_format() -> None:
         with template.open("rb") as fh:
             flagged = [m.id for m in read_po(fh) if m.id and "python-format" in m.flags]
         assert flagged == [], f"{template}: {flagged}"
+
+
+@pytest.mark.slow  # about 30 s: every source file extracted, every rule checked
+def test_the_platforms_own_catalogs_are_current_and_complete(tmp_path: Path) -> None:
+    """What the code and the content say now is what the templates hold (a message added
+    without `i18n extract` reaches no translator: an Urdu grading then shows English),
+    and `i18n check` finds nothing in the course's own catalogs."""
+    from autograder.i18n.glossary import check_all
+    from autograder.i18n.tools import extract
+
+    root = Path(__file__).resolve().parent.parent
+    for fresh in extract(root, tmp_path):
+        with fresh.open("rb") as fh:
+            now = {(m.context, m.id) for m in read_po(fh) if m.id}
+        with (root / "locales" / fresh.name).open("rb") as fh:
+            kept = {(m.context, m.id) for m in read_po(fh) if m.id}
+        assert now - kept == set(), f"not in locales/{fresh.name}: run autograder i18n extract"
+        assert kept - now == set(), f"no longer said, still in locales/{fresh.name}"
+    problems = check_all(root / "locales", root=root)
+    assert problems == [], "\n".join(str(p) for p in problems[:20])

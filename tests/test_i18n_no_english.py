@@ -16,6 +16,7 @@ import zipfile
 from pathlib import Path
 
 import pytest
+from student_runs import Spec, StudentRuns, starter
 
 from autograder.i18n.glossary import load_glossary
 
@@ -107,11 +108,15 @@ def test_list_and_quizzes_in_urdu_have_no_english(allowed: tuple[set[str], set[s
         assert english_outside_code(run.stdout + run.stderr, allowed) == [], run.stdout
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("command", ["check", "grade"])
 def test_check_and_grade_in_urdu_have_no_english(allowed: tuple[set[str], set[str]],
-                                                 command: str) -> None:
-    run = _run(command, EXERCISE, str(STARTER), "--lang", "ur")
-    assert run.returncode == 0, run.stderr
+                                                 command: str,
+                                                 student_runs: StudentRuns) -> None:
+    """The starter's failures, messages and hints in Urdu (the run is shared with
+    tests/test_cli_output.py and tests/test_report_code_order.py)."""
+    [run] = student_runs.get(Spec(command, EXERCISE, starter(EXERCISE), "ur"))
+    assert run.code == 0, run.stderr
     assert "جانچ" in run.stdout + run.stderr
     assert english_outside_code(run.stdout + run.stderr, allowed) == [], run.stdout
 

@@ -1,5 +1,6 @@
 """Code in the Urdu report reads in its written order (issue 32): for each exercise, the
-starter is checked in Urdu as a student would (``check --lang ur --html``), and in headless
+starter is checked in Urdu as a student would (``check --lang ur --html``, a run shared
+with the modules that read the same output: tests/student_runs.py), and in headless
 Chromium every code expression of its messages and hints (a code span, or Latin words
 joined by operators, brackets or commas) has its characters laid out left to right, in
 the order they are written.  A screenshot of each report is kept in the test's tmp_path
@@ -7,15 +8,12 @@ the order they are written.  A screenshot of each report is kept in the test's t
 
 from __future__ import annotations
 
-import json
-import os
 import re
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 from browser import chromium_page
+from student_runs import Spec, StudentRuns, starter
 
 from autograder.i18n.text import CODE_SPAN, ltr_runs
 
@@ -84,19 +82,6 @@ def expressions(text: str) -> set[str]:
     return found
 
 
-def _check_starter(exercise: str, tmp_path: Path) -> tuple[Path, dict]:
-    starter = next((REPO / "assignments" / exercise / "starter").glob("*.py"))
-    html, results = tmp_path / f"report-{exercise}.html", tmp_path / f"{exercise}.json"
-    env = {k: v for k, v in os.environ.items() if k not in ("AUTOGRADER_LANG", "NO_COLOR")}
-    done = subprocess.run(
-        [sys.executable, "-m", "autograder.cli", "check", exercise, str(starter), "--lang", "ur",
-         "--html", str(html), "--results", str(results)],
-        cwd=REPO, env={**env, "PYTHONPATH": str(REPO)}, capture_output=True, text=True,
-        timeout=600)
-    assert done.returncode == 0, done.stderr
-    return html, json.loads(results.read_text(encoding="utf-8"))
-
-
 def test_expressions_are_found_in_a_message() -> None:
     text = ("جو reading شرط `range_min <= r <= range_max` پوری نہ کرے؛ cmd_vel پر "
             "linear.x=0.2, angular.z=0 آیا، اور (goal_x, goal_y) سے دور")
@@ -104,9 +89,13 @@ def test_expressions_are_found_in_a_message() -> None:
                                  "goal_x, goal_y"}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("exercise", EXERCISES)
-def test_every_code_expression_reads_in_written_order(exercise: str, tmp_path: Path) -> None:
-    html, results = _check_starter(exercise, tmp_path)
+def test_every_code_expression_reads_in_written_order(exercise: str, tmp_path: Path,
+                                                      student_runs: StudentRuns) -> None:
+    [run] = student_runs.get(Spec("check", exercise, starter(exercise), "ur"))
+    assert run.code == 0, run.stderr
+    html, results = run.html, run.results
     exprs = set()
     for test in results["tests"]:
         for field in ("message", "hint", "label"):

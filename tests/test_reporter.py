@@ -372,3 +372,36 @@ def test_without_exercise_the_plugin_writes_nothing(pytester: pytest.Pytester) -
     result = pytester.runpytest("-p", "no:cacheprovider")
     result.assert_outcomes(passed=1)
     assert not list(pytester.path.glob("*.json"))
+
+
+def test_a_program_being_started_when_the_run_ends_is_recorded_before_the_reaping() -> None:
+    """The lifeline's watcher reaps what ``ending()`` returns: a start in progress (inside
+    the gate, from before its fork to its record) finishes first, so its program is among
+    them; no program starts after (a killed grading left one running, issue 31)."""
+    import threading
+
+    from autograder.core.errors import GraderError
+    from autograder.plugin.reporter import GradingReporter
+
+    reporter = GradingReporter(None, None, b"")
+    inside, go = threading.Event(), threading.Event()
+
+    def start() -> None:
+        with reporter.spawn_gate:
+            inside.set()
+            go.wait(30)
+            reporter.note_process(4242, [], {})
+
+    starter = threading.Thread(target=start)
+    starter.start()
+    assert inside.wait(30)
+    records: list[list[dict[str, Any]]] = []
+    closer = threading.Thread(target=lambda: records.append(reporter.ending()))
+    closer.start()
+    closer.join(0.2)  # an ungated ending returns here, before the program is recorded
+    go.set()
+    starter.join(30)
+    closer.join(30)
+    assert [r["pid"] for r in records[0]] == [4242]
+    with pytest.raises(GraderError), reporter.spawn_gate:
+        pass

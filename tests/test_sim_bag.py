@@ -23,6 +23,7 @@ from std_msgs.msg import String
 from sim import msgdefs
 from sim.bag import BagRecorder
 from sim.bridge import SimBridge
+from sim.pacing import PacingPolicy
 from sim.physics import World
 from sim.worldfile import load_world
 
@@ -49,7 +50,8 @@ def recorded(ros_domain: int, tmp_path_factory: pytest.TempPathFactory) -> Path:
     folder = tmp_path_factory.mktemp("bags") / "run"
     context = Context()
     rclpy.init(context=context, domain_id=ros_domain)
-    bridge = SimBridge(World(load_world("empty_room")), context, max_clock_hz=50.0)
+    bridge = SimBridge(World(load_world("empty_room")), context,
+                       policy=PacingPolicy(clock_hz=50.0))
     recorder = BagRecorder(folder, mount=(0.05, 0.0, math.pi / 2),
                            custom_data={"world": "empty_room"})
     bridge.add_tap(recorder)
@@ -234,7 +236,8 @@ def test_a_command_after_the_last_tick_still_ends_the_recording(
 
     context = Context()
     rclpy.init(context=context, domain_id=ros_domain)
-    bridge = SimBridge(World(load_world("empty_room")), context, max_clock_hz=50.0)
+    bridge = SimBridge(World(load_world("empty_room")), context,
+                       policy=PacingPolicy(clock_hz=50.0))
     recorder = BagRecorder(tmp_path / "run", mount=(0.0, 0.0, 0.0))
     bridge.add_tap(recorder)
     sender = Node("sender", context=context)

@@ -25,6 +25,7 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
 
 from sim.bridge import SimBridge
+from sim.pacing import PacingPolicy
 from sim.physics import World
 from sim.worldfile import Box, Fault, load_world
 
@@ -68,7 +69,7 @@ def graph(ros_domain: int) -> Iterator[tuple[SimBridge, Probe]]:
     # 50 Hz, not the graded 20: a tick (0.02 s at RTF 1) is then shorter than a busy
     # process's CPU budget (0.05 s), so holding for it visibly slows the world.
     bridge = SimBridge(World(load_world("empty_room")), ctx, real_time_factor=2.0,
-                       max_clock_hz=50.0)
+                       policy=PacingPolicy(clock_hz=50.0))
     probe = Probe(Node("probe", context=ctx,
                        parameter_overrides=[Parameter("use_sim_time", value=True)]))
     executor = SingleThreadedExecutor(context=ctx)
@@ -284,7 +285,7 @@ rclpy.spin(StopBeforeWall())
 
 
 def test_student_process_stops_before_wall(tmp_path, graph: tuple[SimBridge, Probe]) -> None:
-    """A separate use_sim_time process drives on /scan; paced by quiescence it stops in
+    """A separate use_sim_time process drives on /scan; paced by its holds it stops in
     time, in the wall_ahead geometry rebuilt by a run-time obstacle."""
     bridge, probe = graph
     bridge.pause()

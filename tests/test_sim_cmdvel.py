@@ -17,6 +17,7 @@ from rclpy.node import Node
 import sim.cli
 from sim.bridge import SimBridge
 from sim.cmdvel import Mismatch, full_name, twist_of, type_name, world_warning
+from sim.pacing import PacingPolicy
 from sim.physics import World
 from sim.worldfile import load_world
 
@@ -34,7 +35,7 @@ def world(ros_domain: int) -> Iterator[SimBridge]:
     ctx = Context()
     rclpy.init(context=ctx, domain_id=ros_domain)
     bridge = SimBridge(World(load_world("empty_room")), ctx, real_time_factor=2.0,
-                       max_clock_hz=50.0, cmd_vel_type="TwistStamped")
+                       policy=PacingPolicy(clock_hz=50.0), cmd_vel_type="TwistStamped")
     bridge.start()
     try:
         yield bridge

@@ -25,7 +25,7 @@ def _scan(fault: Fault, t: float = 1.0, seed: int = 0):
     ("neg_inf", np.isneginf),
     ("below_min", lambda r: r < Lidar().range_min),
     ("above_max", lambda r: np.isfinite(r) & (r > Lidar().range_max)),
-], ids=str)
+], ids=["nan", "inf", "neg_inf", "below_min", "above_max"])
 def test_per_beam_faults_hit_the_given_fraction(kind: str, check) -> None:
     scan = _scan(Fault(kind=kind, start=0.5, end=2.0, fraction=0.25))
     assert len(scan.ranges) == 360

@@ -18,7 +18,7 @@ import pytest
 from click.testing import CliRunner
 
 from autograder.cli import main
-from autograder.cli.sim_node import exercise_world, node_exercise
+from autograder.commands.hand_run import exercise_world, node_exercise
 from autograder.core.exercise import find_exercise
 
 REPO = Path(__file__).resolve().parent.parent

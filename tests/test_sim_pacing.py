@@ -269,16 +269,41 @@ def test_a_busy_loop_has_no_reserve() -> None:
     assert run.pacer.bursts == 0
 
 
-def test_a_starved_process_holds_until_the_cap() -> None:
-    """Runnable but no CPU (a busy machine): the world waits for it, up to 2 s a tick."""
+def test_a_starved_process_holds_until_the_limit() -> None:
+    """Runnable but no CPU (a busy machine): the world waits for it, hold_cap not counting
+    that time, until hold_limit (10 s) of wall time."""
     clock = FakeClock()
     run = Run(Pacer(DT, 1.0, PacingPolicy(clock_hz=50.0), clock=clock,
                     read_process=FakeProcess(clock, cpu_share=0.0)), clock)
     run.pacer.watch(4242)
-    run.ticks_for(6)
-    assert run.pacer.counts == {"cap": 6}
+    run.ticks_for(3)
+    assert run.pacer.counts == {"cap": 3}
+    assert 10.0 <= run.pacer.longest_hold < 10.0 + 0.005
+    assert run.pacer.effective_rtf < 0.01  # 0.02 s of sim time per 10 s held
+
+
+def test_a_process_starved_for_longer_than_the_cap_is_waited_for() -> None:
+    """A node that waits 3 s for a CPU, then reacts, is not overtaken at hold_cap: the
+    tick goes once it is done (a busy machine must not change what the node saw)."""
+    clock = FakeClock()
+    process = FakeProcess(clock, cpu_share=0.0, idle_at=clock.now + 3.0)
+    run = Run(Pacer(DT, 1.0, clock=clock, read_process=process), clock)
+    run.pacer.watch(4242)
+    run.tick()
+    assert run.pacer.counts == {"idle": 1}
+    assert run.pacer.longest_hold == pytest.approx(3.0, abs=0.005)
+
+
+def test_a_process_that_computes_slowly_is_let_go_at_the_cap() -> None:
+    """Busy and getting some CPU, but less than its budget in hold_cap (2 s): its time
+    counts, and the tick goes at the cap."""
+    clock = FakeClock()
+    run = Run(Pacer(DT, 1.0, PacingPolicy(cpu_reserve=0.0), clock=clock,
+                    read_process=FakeProcess(clock, cpu_share=0.01)), clock)
+    run.pacer.watch(4242)
+    run.tick()
+    assert run.pacer.counts == {"cap": 1}
     assert 2.0 <= run.pacer.longest_hold < 2.0 + 0.001
-    assert run.pacer.effective_rtf < 0.1  # 0.02 s of sim time per 2 s held
 
 
 def _timed_readings(clock: FakeClock, process: FakeProcess) -> tuple[Run, list[float]]:
@@ -289,7 +314,8 @@ def _timed_readings(clock: FakeClock, process: FakeProcess) -> tuple[Run, list[f
         readings.append(clock.now)
         return process(pid)
 
-    pacer = Pacer(DT, 1.0, PacingPolicy(clock_hz=50.0), clock=clock, read_process=read)
+    pacer = Pacer(DT, 1.0, PacingPolicy(clock_hz=50.0, hold_limit=2.0), clock=clock,
+                  read_process=read)
     return Run(pacer, clock), readings
 
 
@@ -304,7 +330,7 @@ def test_readings_of_a_starved_process_back_off_to_the_most_allowed() -> None:
     pauses = [round(b - a, 6) for a, b in zip(readings[1:], readings[2:], strict=False)]
     assert pauses[:5] == [0.0005, 0.001, 0.002, 0.004, 0.004]  # from the first look on
     assert set(pauses[3:]) == {0.004}
-    assert len(readings) < 2.0 / 0.004 + 5  # about 500 readings in the 2 s cap, not 4000
+    assert len(readings) < 2.0 / 0.004 + 5  # about 500 readings in 2 s, not 4000
 
 
 def test_a_process_that_computes_is_read_every_poll_interval() -> None:
@@ -326,11 +352,32 @@ def test_held_seconds_count_holds_past_the_deadline_only() -> None:
     run.pacer.watch(4242)
     run.ticks_for(3)  # idle after 30 ms: within the 50 ms period
     assert run.pacer.held_seconds == 0.0
-    starved = Run(Pacer(DT, 1.0, PacingPolicy(clock_hz=50.0), clock=clock,
+    starved = Run(Pacer(DT, 1.0, PacingPolicy(clock_hz=50.0, hold_limit=2.0), clock=clock,
                         read_process=FakeProcess(clock, cpu_share=0.0)), clock)
     starved.pacer.watch(4242)
-    starved.ticks_for(3)  # held to the 2 s cap, the period being 20 ms
+    starved.ticks_for(3)  # held to the 2 s limit, the period being 20 ms
     assert starved.pacer.held_seconds == pytest.approx(3 * (2.0 - 0.02), abs=0.003)
+
+
+def test_a_process_read_idle_once_is_read_again() -> None:
+    """One reading of a process goes thread by thread, so a thread woken by another just
+    after it was read, its waker asleep by the time it is read, makes a working process
+    read idle once. The tick goes only when a second reading agrees."""
+    clock = FakeClock()
+
+    def read(pid: int) -> ProcessState:
+        t = clock.now - clock.ticks[-1] if clock.ticks else 0.0
+        before = len(clock.ticks) * 0.02  # CPU seconds of the ticks before
+        if 0.0018 <= t < 0.0023:  # the reading that falls between waker and woken
+            return ProcessState(busy=False, cpu_ns=round((before + 0.0018) * 1e9))
+        used = min(t, 0.0018) + max(0.0, min(t, 0.01) - 0.0023)
+        return ProcessState(busy=t < 0.01, cpu_ns=round((before + used) * 1e9))
+
+    run = Run(Pacer(DT, 1.0, clock=clock, read_process=read), clock)
+    run.pacer.watch(4242)
+    run.ticks_for(3)
+    assert run.pacer.counts == {"idle": 3}
+    assert run.pacer.longest_hold == pytest.approx(0.0105, abs=0.001)  # done at 10 ms
 
 
 def test_every_watched_process_must_be_done() -> None:
@@ -410,6 +457,27 @@ def test_a_tick_heard_after_the_timeout_still_counts_as_heard() -> None:
     assert run.pacer.counts == {"unheard": 1, "idle": 2} and run.pacer.late_deliveries == 2
 
 
+def test_a_tick_still_on_its_way_is_waited_for_past_the_hear_timeout() -> None:
+    """While the kernel still holds packets it has not delivered (its receive work left
+    to ksoftirqd on a busy machine), the tick may be on its way: the process is not given
+    up on as deaf, and the next tick does not overtake it."""
+    clock = FakeClock()
+    process = FakeProcess(clock, idle_at=clock.now, delay=0.7, reaction=0.01)
+    run = Run(Pacer(DT, 1.0, clock=clock, read_process=process,
+                    delivering=lambda: clock.now < clock.ticks[-1] + 0.7), clock)
+    run.pacer.watch(4242)
+    run.ticks_for(3)
+    assert run.pacer.counts == {"idle": 3} and run.pacer.late_deliveries == 3
+    assert run.pacer.longest_hold == pytest.approx(0.71, abs=0.002)  # heard, then done
+    deaf = FakeProcess(clock, idle_at=clock.now, hears_from=math.inf)
+    run = Run(Pacer(DT, 1.0, clock=clock, read_process=deaf,
+                    delivering=lambda: clock.now < clock.ticks[-1] + 0.7), clock)
+    run.pacer.watch(4242)
+    run.ticks_for(2)  # nothing more in flight after 0.7 s: deaf, once
+    assert run.pacer.counts == {"unheard": 1, "idle": 1}
+    assert run.gaps() == pytest.approx([0.7], abs=0.005)
+
+
 def test_a_tick_waits_for_the_world_to_take_in_what_was_sent() -> None:
     """A node idle after publishing has sent its command, but the world's own receive
     thread may still wait for a CPU: the next tick goes once the world has taken it in,
@@ -460,7 +528,8 @@ def test_a_long_hold_is_not_caught_up() -> None:
     """After holds of 2 s, the next free ticks keep 1 / clock_hz apart."""
     clock = FakeClock()
     process = FakeProcess(clock, cpu_share=0.0, idle_at=clock.now + 5.0)
-    run = Run(Pacer(DT, 1.0, clock=clock, read_process=process), clock)
+    run = Run(Pacer(DT, 1.0, PacingPolicy(hold_limit=2.0), clock=clock,
+                    read_process=process), clock)
     run.pacer.watch(4242)
     run.ticks_for(10)
     assert run.pacer.counts == {"cap": 2, "idle": 8}  # the third hold ends at 5 s

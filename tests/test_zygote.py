@@ -22,6 +22,9 @@ from autograder.sandbox.contained.zygote import ForkedProcess
 from autograder.sandbox.process import LaunchFailed, StudentProcess, student_process
 
 ROOT = Path(__file__).resolve().parents[1]
+# Wall seconds a program may take to start or to end: generous, for a loaded machine (a
+# fast-tier run beside other work once took more than 30 s to print its first line).
+WALL = 240.0
 
 SELF = """\
 import os, sys
@@ -48,7 +51,7 @@ callback()
     "interrupted": SELF + """\
 import time
 print("waiting", flush=True)
-time.sleep(60)
+time.sleep(3600)  # ended by the test's Ctrl-C only, however slow the machine
 """,
 }
 
@@ -63,12 +66,13 @@ def _run(tmp_path: Path, name: str, forked: bool,
                               course=ROOT)
     program.start()
     try:
-        if name == "interrupted":
-            end = time.monotonic() + 30
-            while "waiting" not in program.output_text() and time.monotonic() < end:
+        if name == "interrupted":  # Ctrl-C once the program runs its own code, not before
+            end = time.monotonic() + WALL
+            while "waiting" not in program.output_text():
+                assert time.monotonic() < end, f"never printed 'waiting' ({forked=})"
                 time.sleep(0.01)
             program.signal(signal.SIGINT)
-        status = program.wait(30.0)
+        status = program.wait(WALL)
     finally:
         program.stop()
     output = re.sub(r"/\S+/(prog\.py)", r"\1", program.output_text())

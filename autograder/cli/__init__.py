@@ -8,7 +8,6 @@ file); 3 when the autograder itself failed (:mod:`autograder.cli.exits`).
 from __future__ import annotations
 
 import json
-import shutil
 import signal
 from collections.abc import Callable
 from pathlib import Path
@@ -17,6 +16,7 @@ from typing import TYPE_CHECKING, Any, TypeVar
 import click
 
 from autograder import __version__
+from autograder.cli import click_words
 from autograder.cli.exits import GraderFault, UsageProblem, report_problems
 from autograder.core.dumpable import not_dumpable
 from autograder.core.errors import ContentError, GraderError, UsageError
@@ -25,6 +25,8 @@ from autograder.i18n import LANGUAGES, _, ngettext, set_language
 
 if TYPE_CHECKING:
     from autograder.core.exercise import Exercise
+
+click_words.speak()  # click's own words (usage errors) in the active language, from here on
 
 F = TypeVar("F", bound=Callable[..., Any])
 
@@ -58,8 +60,7 @@ def _i18n_cli() -> click.Command:
 class LazyGroup(click.Group):
     """A group whose sub-groups are imported when they are called: ``sim`` brings numpy,
     pymunk and the world, ``quiz`` and ``i18n`` Babel, and ``grade`` and ``check`` need none
-    of it. Imported at start they cost every command 0.1 s and the grader's process 45 MB
-    resident where 22 would do, held all through a grading."""
+    of it, in time or in the grader's memory held all through a grading."""
 
     lazy = {"sim": _sim_cli, "quiz": _quiz_cli, "i18n": _i18n_cli}
 
@@ -191,20 +192,9 @@ def _quizzes() -> list:
 def start(exercise: str, directory: Path | None) -> None:
     """Copy an exercise's starter code, README and own world file into DIRECTORY (default:
     the exercise id)."""
-    found = _exercise(exercise)
-    target = directory or Path(found.id)
-    target.mkdir(parents=True, exist_ok=True)
-    copied = []
-    # A world kept in the exercise's folder goes too: the README's hand run names it there.
-    world = found.folder / found.world
-    own_world = [world] if world.suffix in (".yaml", ".yml") and world.is_file() else []
-    for source in (found.starter, *sorted(found.folder.glob("README*.md")), *own_world):
-        dest = target / source.name
-        if dest.exists():
-            raise UsageProblem(_("{path} already exists; not overwriting your work").format(
-                path=dest))
-        shutil.copy2(source, dest)
-        copied.append(dest)
+    from autograder.commands.start import start as copy_starter
+
+    found, target, copied = copy_starter(exercise, directory)
     for path in copied:
         click.echo(_("created {path}").format(path=path))
     click.echo(_("Next: edit {file}, then run `autograder check {exercise} {file}`").format(

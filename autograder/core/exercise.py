@@ -65,12 +65,12 @@ class Exercise:
         "Pace of simulation time against wall time (0: as fast as the graph keeps up)."))
     clock_hz: float = dataclasses.field(default=DEFAULT_CLOCK_HZ, metadata=_doc(
         "Most /clock messages per wall second. Jazzy's MultiThreadedExecutor keeps a 10 Hz "
-        "sim-time timer exact at 20 Hz but stutters from about 50 Hz (measured)."))
+        "sim-time timer exact at 20 Hz but stutters from about 50 Hz."))
     cpu_budget: float = dataclasses.field(default=DEFAULT_CPU_BUDGET, metadata=_doc(
         "CPU seconds the student's process may use after a clock tick before the world "
         "moves on without it, beyond which it draws on a reserve of up to 2 s that ticks "
-        "it spends idle pay back. Jazzy's MultiThreadedExecutor can spin for 50-250 ms of "
-        "CPU while it hands callbacks to its threads (rclpy issue 1452): raise this for "
+        "it spends idle pay back. Jazzy's MultiThreadedExecutor spins while it hands "
+        "callbacks to its threads (docs/students/exercises.md): raise this for "
         "multi-threaded nodes; a busy loop then slows the world by this much per tick."))
     startup_timeout: float = dataclasses.field(default=20.0, metadata=_doc(
         "Wall seconds the node has to appear on the ROS graph after its process starts."))

@@ -24,21 +24,15 @@ from autograder.core.results import RunResult
 from autograder.i18n import _, ngettext
 
 # Cores the gradings may ask for together, as a multiple of the cores there are. Above 1:
-# a grading measured alone also waits on things that do not need a CPU (the clock's wall
-# deadlines, a node's exit), and its demand comes in bursts (start-up, then ticks), so the
-# gaps are filled only well past the cores; past that each grading only stretches, the
-# pacing holding simulation time for a process that waits for a CPU. On 2 cores
-# error_handling's 16 students went at 294 an hour at 0.75 (3 at once), 448 at 1.25 (5)
-# and 596 with 8 at once (2.0 at its 0.46 of a core), and 8 at once graded faster than 4
-# for every exercise but parameter_validation, and than 1.25's choice for all five, every
-# score full (docs/contributors/measurements.md). A grading that fills a core by itself
-# gets two per core: no faster, no slower.
+# a grading also waits on things that need no CPU (the clock's wall deadlines, a node's
+# exit) and its demand comes in bursts, so the gaps fill only well past the cores; past
+# that each grading only stretches, the pacing holding simulation time for a process that
+# waits for a CPU (the figures: docs/contributors/measurements.md, "--jobs auto").
 TARGET_LOAD = 2.0
-# Most gradings at once: the highest concurrency measured to keep every score full
-# (docs/contributors/measurements.md, benchmarks/bench_batch.py).
+# Most gradings at once: the most shown to keep every score full (the same section).
 MAX_JOBS = 8
-# Resident memory of one grading (pytest child, simulator, student node), measured ~250 MB;
-# rounded up so a node that allocates more still fits.
+# Resident memory of one grading (pytest child, simulator, student node), with room for a
+# node that allocates more than a reference solution does.
 GRADING_MB = 400.0
 # Least CPU share believed of a grading: a first student that only hangs measures little.
 MIN_SHARE = 0.15

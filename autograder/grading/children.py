@@ -26,7 +26,9 @@ from autograder.core.report import RawReport, RawTest
 from autograder.core.settings import RunSettings
 from autograder.grading.footprint import Footprint
 from autograder.sandbox.domains import DomainLock
+from autograder.sandbox.isolation import student_uid
 from autograder.sandbox.process import reap_recorded
+from autograder.sandbox.sweep import sweep_user
 
 Progress = Callable[[RawTest], None]
 
@@ -48,6 +50,8 @@ class Child:
     key: bytes
     log_path: Path
     launched: float  # monotonic, the same clock in both processes
+    # The student's own user in this child's runs (strict and user isolation), else None.
+    uid: int | None = None
     timed_out: bool = False
     stopped: bool = False  # something stopped it (SIGSTOP): what it reports is not trusted
     # The report's tests as last read, and the file's (inode, size, mtime) then.
@@ -56,9 +60,8 @@ class Child:
 
     def reported_tests(self) -> list[RawTest]:
         """The tests as the report says now, read again only when the file changed: it is
-        replaced whole on each write (a new inode), and unchanged most of the time. With
-        the world's recordings in it, a report of a few hundred KB parsed four times a
-        second cost error_handling's grading 0.7 CPU-seconds."""
+        replaced whole on each write (a new inode), and unchanged most of the time, while
+        parsing it (the world's recordings in it) is not cheap."""
         try:
             stat = self.report_path.stat()
         except OSError:
@@ -117,6 +120,22 @@ def bytecode_env(env: dict[str, str]) -> dict[str, str]:
     return env
 
 
+# What the grader's environment may say to any pytest: options (-x stops at the first
+# failed test, and with it the score), plugins to load, whether to load installed ones.
+_PYTEST_VARIABLES = ("PYTEST_ADDOPTS", "PYTEST_PLUGINS", "PYTEST_DISABLE_PLUGIN_AUTOLOAD",
+                     "PYTEST_DEBUG", "PYTEST_CURRENT_TEST", "PYTEST_VERSION")
+
+
+def pytest_env(env: dict[str, str]) -> dict[str, str]:
+    """``env`` for a child pytest: the same tests, options and plugins whoever grades.
+    Nothing of the caller's pytest settings reaches it, and no installed plugin loads but
+    ours (named with ``-p``): a pytest-randomly would reorder the tests, a rerun plugin
+    grade twice, an ``-x`` in ``PYTEST_ADDOPTS`` stop at the first failure."""
+    env = {k: v for k, v in env.items() if k not in _PYTEST_VARIABLES}
+    env["PYTEST_DISABLE_PLUGIN_AUTOLOAD"] = "1"
+    return env
+
+
 @contextlib.contextmanager
 def started(prefix: Sequence[str], settings: RunSettings, targets: Sequence[str],
             folder: Path, rootdir: Path, lock: DomainLock, *,
@@ -133,10 +152,10 @@ def started(prefix: Sequence[str], settings: RunSettings, targets: Sequence[str]
                                    lifeline_fd=life_read, domain=lock.domain)
     command = [
         *prefix, sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
-        "--rootdir", str(rootdir), "--basetemp", str(folder / "pytest"),
-        "--autograder-settings", settings.to_json(), *targets,
+        "-p", "autograder.plugin", "--rootdir", str(rootdir), "--basetemp",
+        str(folder / "pytest"), "--autograder-settings", settings.to_json(), *targets,
     ]
-    env = bytecode_env(dict(os.environ))
+    env = pytest_env(bytecode_env(dict(os.environ)))
     if not zygote:
         env["AUTOGRADER_ZYGOTE"] = "0"
     log_path = folder / "pytest.log"
@@ -151,7 +170,8 @@ def started(prefix: Sequence[str], settings: RunSettings, targets: Sequence[str]
         os.close(life_read)
         with os.fdopen(key_write, "wb") as pipe:
             pipe.write(key)
-        yield Child(process, report_path, key, log_path, launched)
+        yield Child(process, report_path, key, log_path, launched,
+                    student_uid(lock.domain) if settings.own_user else None)
     finally:
         os.close(life_write)
 
@@ -235,6 +255,10 @@ def abandon(running: Sequence[Child], grace: float = 10.0) -> None:
             child.process.wait(5.0)
         for process in report.read(child.report_path, child.key).processes:
             reap_recorded(process)
+        # A program the child was starting when it was killed has no record: where the
+        # student has a user of its own, that user's sweep ends it all the same.
+        if child.uid is not None:
+            sweep_user(child.uid)
 
 
 def end(child: Child) -> Ended:

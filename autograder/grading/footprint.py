@@ -15,9 +15,8 @@ and being read counts nothing. A sample never fails.
 The tree is the grader itself and each child pytest (which holds the world and the probe)
 with all its descendants (the students' programs and anything they started), found
 through each thread's ``/proc/PID/task/TID/children``: that reads a file per thread of
-the tree (about 70 in a grading of two children, 0.5 ms), where a scan of every
-``/proc/PID/stat`` for parent ids reads one per process on the machine (1.2 ms with 70
-processes, 4.5 ms with 320). The grader counts alone: in ``grade-batch`` its other
+the tree, where a scan of every ``/proc/PID/stat`` for parent ids would read one per
+process on the machine. The grader counts alone: in ``grade-batch`` its other
 descendants are other gradings'. A process whose parent ended has left the tree (the
 kernel gives it to init), so it is not counted; nor is a peak that comes and goes between
 two samples.
@@ -33,12 +32,9 @@ from collections.abc import Sequence
 from pathlib import Path
 
 PROC = Path("/proc")
-# Seconds between samples: a grading's memory changes as its processes start (each test
-# starts the student's program, which takes seconds to its node), slower than that. A
-# sample costs 7 to 12 ms of CPU, nearly all the kernel's (reading a rollup walks the
-# process's page tables, about 3 ms per 100 MB resident): every 0.5 s that was 1 to 3% of
-# a grading's CPU, and its peaks agreed within 2 MB with a sampler every 50 ms; every
-# second, about 1%, timer_sync's and error_handling's peaks 2 MB lower than at 0.5 s.
+# Seconds between samples: a grading's memory changes as its processes start, slower than
+# that, and a sample's CPU (the kernel walks each process's page tables) must stay a small
+# part of a grading's (docs/contributors/measurements.md, "Memory sampling").
 INTERVAL = 1.0
 
 

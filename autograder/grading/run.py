@@ -215,11 +215,8 @@ def _run(exercise: Exercise, submission: Path | None, plan: _Plan,
     """One grading in child pytests, one per reserved domain; the result and the merged
     raw report. Each child gets its :class:`~autograder.core.settings.RunSettings` as one
     document (see :mod:`autograder.grading.children`). Every child forks students'
-    programs from a zygote of its own (in its own namespaces): a zygote costs about what
-    one exec'd start does and each later start is a fork, so a node is on the graph in
-    about 0.3 s instead of 1 to 1.5 on a busy 2-core machine, and error_handling's eight
-    starts cost 1.8 CPU-seconds less, for 25 to 57 MB more footprint
-    (benchmarks/RESULTS.md)."""
+    programs from a zygote of its own (in its own namespaces), so each start after the
+    first is a fork, not an exec (docs/contributors/design.md, "Warm starts")."""
     targets = plan.targets(len(locks))
     settings = RunSettings(
         domains=tuple(lock.domain for lock in locks),

@@ -62,9 +62,6 @@ def set_language(lang: str) -> None:
     ``_``: they import nothing of ``autograder``)."""
     global _active
     _active = lang
-    from autograder.i18n import click_words
-
-    click_words.speak()
     content.i18n.set_language(
         lang, lambda: catalog_folder(content.i18n.get_language()).parent.parent)
 

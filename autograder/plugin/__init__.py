@@ -15,7 +15,7 @@ The modules: ``reporter`` (outcomes into the raw report), ``world`` (exercise, r
 context, world and probe fixtures), ``student`` (starting and watching the student's
 program), ``guard`` (tampering), ``msgtypes`` (message types that never match the
 grader's), ``credit`` (partial credit and evidence), ``probe`` (the grader's node),
-``stash`` (the plugin's state on pytest's config).
+``markers`` (the markers and their check), ``stash`` (the plugin's state on pytest's config).
 """
 
 from __future__ import annotations
@@ -24,7 +24,6 @@ import contextlib
 import os
 import signal
 import threading
-from fractions import Fraction
 
 import pytest
 
@@ -34,6 +33,7 @@ from autograder.core.settings import RunSettings
 from autograder.i18n import set_language
 from autograder.plugin.credit import credit, evidence
 from autograder.plugin.guard import _graph_guard
+from autograder.plugin.markers import MARKERS, marker_problem
 from autograder.plugin.reporter import GradingReporter
 from autograder.plugin.stash import reporter_key, settings_key
 from autograder.plugin.student import start_node, student
@@ -43,15 +43,6 @@ from autograder.plugin.world import exercise, probe, ros_context, submission_fil
 __all__ = ["GradingReporter", "_graph_guard", "credit", "evidence", "exercise", "probe",
            "ros_context", "start_node", "student", "submission_file", "world"]
 
-MARKERS = {
-    "points": "points(n): points the test is worth, a positive number (default 1)",
-    "visibility": "visibility(v): 'visible', 'hidden' or 'after_published' (default: hidden "
-                  "for tests under a hidden/ folder)",
-    "world": "world(name): the world this module's tests run in",
-    "parameters": "parameters(dict): -p overrides the module's `student` node starts with",
-    "reveal": "reveal(what): what a student sees of a failure: 'message' or 'status' "
-              "(default: 'message' for visible tests, 'status' for hidden ones)",
-}
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:
@@ -123,28 +114,11 @@ def _watch_lifeline(fd: int, reporter: GradingReporter) -> None:
                 pass
         from autograder.sandbox.process import reap_recorded
 
-        for process in list(reporter.data["processes"]):
+        for process in reporter.ending():
             reap_recorded(process)
         os.killpg(os.getpgrp(), signal.SIGKILL)
 
     threading.Thread(target=watch, daemon=True, name="autograder-lifeline").start()
-
-
-def marker_problem(item: pytest.Item) -> str | None:
-    """What is wrong with a test's markers, for its author; None if nothing."""
-    checks = {
-        "points": lambda v: isinstance(v, (int, Fraction)) and not isinstance(v, bool)
-        and v > 0 or isinstance(v, float) and v > 0,
-        "visibility": lambda v: v in ("visible", "hidden", "after_published"),
-        "reveal": lambda v: v in ("message", "status"),
-        "world": lambda v: isinstance(v, str) and bool(v),
-        "parameters": lambda v: isinstance(v, dict),
-    }
-    for name, valid in checks.items():
-        marker = item.get_closest_marker(name)
-        if marker is not None and (len(marker.args) != 1 or not valid(marker.args[0])):
-            return f"{item.nodeid}: marker {MARKERS[name]}; got {marker.args!r}"
-    return None
 
 
 def pytest_runtest_setup(item: pytest.Item) -> None:

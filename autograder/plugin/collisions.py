@@ -18,10 +18,11 @@ from autograder.i18n import _
 from sim.physics import Contact
 from sim.recorder import Sample
 
-# Half-width of "straight ahead": a robot whose node watched the wrong beam hits head on
-# (a few degrees off), while a glancing touch of a wall beside the path is 45 degrees or
-# more off.  20 degrees keeps the note to the first kind.
-AHEAD = math.radians(20)
+# Half-width of "ahead": the front sector the exercise READMEs teach a node to watch
+# (their `front_sector`, ±30 degrees).  A node that watched it would have seen what the
+# robot touched there, so a touch within it says the node watched another beam; a
+# glancing touch of a wall beside the path is further off.
+AHEAD = math.radians(30)
 
 Geometry = tuple[np.ndarray, np.ndarray]
 """``World.geometry``: segments (N, 4) [x1 y1 x2 y2] and circles (M, 3) [x y r]."""

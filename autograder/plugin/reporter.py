@@ -4,6 +4,7 @@ goes (registered by :mod:`autograder.plugin` only when an exercise is graded).""
 from __future__ import annotations
 
 import resource
+import threading
 import time
 import traceback
 from collections.abc import Iterator
@@ -26,6 +27,7 @@ from autograder.core.output_budget import (
 from autograder.core.report import RawTest
 from autograder.core.results import exact
 from autograder.i18n import _
+from autograder.plugin.markers import marker_problem
 from autograder.plugin.msgtypes import type_note
 from autograder.plugin.stash import credit_key, evidence_key, settings_key, world_key
 from autograder.plugin.timing import Timing, module_of
@@ -51,6 +53,29 @@ def _visibility(item: pytest.Item, hidden_default: str) -> str:
     return hidden_default if "hidden" in Path(str(item.path)).parts else "visible"
 
 
+class SpawnGate:
+    """Student programs start through this gate (``StudentProcess.gate``), one at a time
+    with their record. Closed once and for good when the run ends: a start in progress
+    finishes and is recorded first, a later one fails."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._closed = False
+
+    def __enter__(self) -> None:
+        self._lock.acquire()
+        if self._closed:
+            self._lock.release()
+            raise GraderError(_("The grading is ending: no program starts now."))
+
+    def __exit__(self, *_exc: object) -> None:
+        self._lock.release()
+
+    def close(self) -> None:
+        with self._lock:
+            self._closed = True
+
+
 class GradingReporter:
     """Collects each test's outcome, points and message; writes the raw report as it goes."""
 
@@ -64,6 +89,7 @@ class GradingReporter:
                                      "processes": []}
         self.hidden_default = "after_published"
         self.timing = Timing()
+        self.spawn_gate = SpawnGate()
         self._sim_began = 0.0
 
     def write(self) -> None:
@@ -78,6 +104,12 @@ class GradingReporter:
         if self.path is not None and text:
             report.keep_log(self.path, self.data, nodeid, text)
         self.write()
+
+    def ending(self) -> list[dict[str, Any]]:
+        """The run is ending (its grader is gone): no student program starts from now on,
+        and one being started is recorded first. The records of every program started."""
+        self.spawn_gate.close()
+        return list(self.data["processes"])
 
     def note_process(self, pid: int, cgroups: list[str], bounds: dict[str, Any],
                      workdir: str | None = None, uid: int | None = None) -> None:
@@ -207,8 +239,6 @@ def peak_memory() -> dict[str, float]:
 
 def _points(item: pytest.Item) -> Any:
     """The points a test is worth (its ``points`` marker, else 1)."""
-    from autograder.plugin import marker_problem
-
     if marker_problem(item) is not None:
         return 1  # the test errs at setup, naming the problem
     marker = item.get_closest_marker("points")

@@ -162,6 +162,7 @@ def _launch(request: pytest.FixtureRequest, exercise: Exercise, script: Path, pr
             # ordinary grading user (where it counts that user's other processes too).
             process.cgroup.bounds(separate_uid=process.uid is not None or os.geteuid() != 0),
             str(process.workdir) if process.uid is not None else None, process.uid)
+        process.gate = reporter.spawn_gate
     process.start()
     world.watch_pid(process.pid)
     node = StudentNode(process, exercise.node, probe, _log_keeper(request),

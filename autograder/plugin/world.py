@@ -131,11 +131,12 @@ def _make_world(exercise: Exercise, spec: WorldSpec, ros_context: Context,
                 rtf: float | None) -> SimBridge:
     """The world for ``spec`` on the run's context, not yet started."""
     from sim.bridge import SimBridge
+    from sim.pacing import PacingPolicy
     from sim.physics import World
 
     return SimBridge(World(spec), ros_context, node_name=WORLD_NODE_NAME,
-                     max_clock_hz=exercise.clock_hz,
-                     cpu_budget=exercise.cpu_budget,
+                     policy=PacingPolicy(clock_hz=exercise.clock_hz,
+                                         cpu_budget=exercise.cpu_budget),
                      real_time_factor=exercise.real_time_factor if rtf is None else rtf,
                      cmd_vel_type=exercise.cmd_vel_type)
 

@@ -62,7 +62,7 @@ from autograder.core.exercise import Limits
 Version = Literal["v1", "v2"]
 # ``cpu`` sets no limit: a group of its own makes the program one entity for the CPU
 # scheduler whatever it forks, so a student's spinning children take one share, not one
-# per child, from the gradings running beside it (issue 28).
+# per child, from the gradings running beside it.
 CONTROLLERS = ("pids", "memory", "cpu")
 # The file that carries each controller's limit, per hierarchy.
 LIMIT_FILES: dict[Version, dict[str, str]] = {
@@ -93,7 +93,7 @@ def _v1_folder(mount: Path, controller: str, name: str) -> Path:
     """Where a run's v1 group of ``controller`` lives. ``cpu`` groups sit at the top of
     their hierarchy, beside the grader's own processes: under a shared parent, every
     student of every grading would weigh as one thread of the grader's, and a batch's
-    programs would starve (measured: a memory bomb too slow to reach its limit)."""
+    programs would starve."""
     return mount / (f"{PARENT}-{name}" if controller == "cpu" else f"{PARENT}/{name}")
 
 

@@ -7,9 +7,8 @@ as a user of its own (uid ``STUDENT_UID_BASE + domain``), in a mount namespace w
 course's hidden tests, solutions and project tests are covered by empty read-only
 filesystems, with a size-limited tmpfs as working directory.  Fast DDS then speaks UDP
 only: its shared-memory segments, created by root, are not writable by the student's
-user and traffic silently stops (measured), and ``ROS_AUTOMATIC_DISCOVERY_RANGE=
-LOCALHOST`` also cut the student off from a root peer (measured), while the namespace
-already confines discovery to loopback.
+user, and ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST`` would cut the student off from a
+root peer; the namespace already confines discovery to loopback.
 
 **User** (the grader runs as root where namespaces are refused: Gradescope's container, a
 Kubernetes pod, both without ``CAP_SYS_ADMIN``): the student still runs as a user of its
@@ -18,8 +17,8 @@ default. What namespaces did is done by ownership and mode: the course's protect
 are closed to other users (:func:`close_to_others`), the student's folder is its own
 (0700), and whatever its user leaves is swept (:mod:`autograder.sandbox.sweep`). Fast DDS
 speaks UDP on loopback only (:data:`LOOPBACK_PROFILE`): with shared memory the student's
-user cannot use segments root made, and ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST`` cut a
-root participant off from another user's (both measured). The program keeps the network
+user cannot use segments root made, and ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST`` cuts a
+root participant off from another user's. The program keeps the network
 and sees the machine's processes: no namespace can take them away here.
 
 **Basic** (anything else: an ordinary user; ``AUTOGRADER_ISOLATION=basic``): process
@@ -98,18 +97,18 @@ def detect() -> Isolation:
     elif shutil.which("unshare") is None:
         strict = Isolation("user", N_("the unshare command (util-linux) is missing"))
     else:
-        strict = _probe(Isolation("strict"))
+        strict = _check(Isolation("strict"))
         if strict.mode == "strict":
             return strict
     # No namespaces: a user of its own all the same, if a test program runs as one.
-    own = _probe(Isolation("user", strict.reason, strict.detail))
+    own = _check(Isolation("user", strict.reason, strict.detail))
     if own.mode == "user":
         return own
     return Isolation("basic", own.reason, " / ".join(d for d in (strict.detail, own.detail)
                                                       if d))
 
 
-def _probe(isolation: Isolation) -> Isolation:
+def _check(isolation: Isolation) -> Isolation:
     """``isolation`` if a test program runs in it as a student's does; else basic, why."""
     command = [*run_prefix(isolation),
                *module_command("autograder.sandbox.startup_check", [isolation.mode])]
@@ -126,11 +125,11 @@ def _probe(isolation: Isolation) -> Isolation:
             if isinstance(exc, subprocess.TimeoutExpired):
                 return Isolation("basic", _could_not(isolation), "no answer within 120 s")
             raise
-    probe = subprocess.CompletedProcess(command, running.returncode, out, err)
-    if probe.returncode == 0:
+    checked = subprocess.CompletedProcess(command, running.returncode, out, err)
+    if checked.returncode == 0:
         return isolation
-    detail = " / ".join((probe.stdout + probe.stderr).strip().splitlines()[-3:])
-    if probe.stderr.startswith("unshare:"):  # the namespaces themselves were refused
+    detail = " / ".join((checked.stdout + checked.stderr).strip().splitlines()[-3:])
+    if checked.stderr.startswith("unshare:"):  # the namespaces themselves were refused
         return Isolation("basic", N_("namespaces are not allowed here (an unprivileged "
                                      "container?)"), detail)
     return Isolation("basic", _could_not(isolation), detail)

@@ -3,9 +3,9 @@ program must not have (the launcher and the start-up check run as root until the
 contained the program): nothing of the student's may be on its module path.
 
 ``python -m MODULE`` puts its working directory first on the module path, and so does
-``python -c``: started from the student's folder, a ``json.py`` or ``ctypes.py`` placed
-beside the node was imported by the launcher as root, before any namespace, limit or
-change of user (issue 28). So such a process is started in isolated mode (``-I``: no
+``python -c``: started from the student's folder, a ``json.py`` placed beside the node
+would be imported as root, before any namespace, limit or change of user. So such a
+process is started in isolated mode (``-I``: no
 working directory or script folder on the path, no ``PYTHON*`` variables, no user
 site-packages), from ``/``, with only this platform's own checkout put on the path.
 """

@@ -291,6 +291,9 @@ class StudentProcess:
     # Called as soon as the launcher's process exists, before it is contained: whoever
     # must reap it if the grader dies can know it from the start.
     on_spawn: Callable[[], None] | None = None
+    # Held from before the fork until ``on_spawn`` returned: whoever ends the run closes it
+    # first, so a program is either recorded before the run reaps, or never started.
+    gate: contextlib.AbstractContextManager[object] | None = None
     # Also given every chunk of output as it comes (a hand run streams it to the terminal).
     echo: Callable[[bytes], None] | None = None
     _reader: threading.Thread | None = None
@@ -318,11 +321,13 @@ class StudentProcess:
         if self.uid is not None:
             with _users_lock:
                 _users.setdefault(self.uid, set()).add(id(self))
-        started = self._fork(spec, args, launcher_env) or self._exec(spec, args, launcher_env)
-        self.popen, status_read = started
-        self.started_at = time.monotonic()
-        if self.on_spawn is not None:
-            self.on_spawn()
+        with self.gate if self.gate is not None else contextlib.nullcontext():
+            started = (self._fork(spec, args, launcher_env)
+                       or self._exec(spec, args, launcher_env))
+            self.popen, status_read = started
+            self.started_at = time.monotonic()
+            if self.on_spawn is not None:
+                self.on_spawn()
         self._reader = threading.Thread(target=self._read, daemon=True, name="student-output")
         self._reader.start()
         try:

@@ -18,17 +18,17 @@ from autograder.sandbox.isolation import Mode, bring_up_loopback, student_uid
 from autograder.sandbox.privileged import PACKAGE_PARENT
 
 # What the start-up check's test program runs: Python, rclpy and its middleware.
-PROBE_PROGRAM = """\
+TEST_PROGRAM = """\
 import os
 import rclpy
 
 rclpy.init()
 rclpy.shutdown()
-print("autograder-probe-ok", os.getuid())
+print("autograder-check-ok", os.getuid())
 """
 
 
-def probe_launch(mode: Mode = "strict") -> str | None:
+def check_launch(mode: Mode = "strict") -> str | None:
     """Start a test program exactly as a student's is started in isolation ``mode``; None
     if it ran as its own user, else what went wrong. Runs inside the run's namespaces."""
     import tempfile
@@ -38,11 +38,11 @@ def probe_launch(mode: Mode = "strict") -> str | None:
 
     if mode == "strict":
         bring_up_loopback()
-    with tempfile.TemporaryDirectory(prefix="autograder-probe-",
+    with tempfile.TemporaryDirectory(prefix="autograder-check-",
                                      ignore_cleanup_errors=True) as tmp:
-        script = Path(tmp) / "staged" / "probe.py"
+        script = Path(tmp) / "staged" / "check.py"
         script.parent.mkdir()
-        script.write_text(PROBE_PROGRAM)
+        script.write_text(TEST_PROGRAM)
         process = student_process(script, [], Limits(), domain=0, mode=mode,
                                   course=Path(PACKAGE_PARENT))
         try:
@@ -55,7 +55,7 @@ def probe_launch(mode: Mode = "strict") -> str | None:
             if process.popen is not None:
                 process.stop(grace=1.0)
             shutil.rmtree(process.workdir, ignore_errors=True)
-        expected = f"autograder-probe-ok {student_uid(0)}"
+        expected = f"autograder-check-ok {student_uid(0)}"
         if status == 0 and expected in process.output_text():
             return None
         return (f"the test program exited with status {status}: "
@@ -64,7 +64,7 @@ def probe_launch(mode: Mode = "strict") -> str | None:
 
 
 def _stop_as_ctrl_c() -> None:
-    """SIGTERM, SIGHUP, and the grader's death (``PR_SET_PDEATHSIG``) end the probe as
+    """SIGTERM, SIGHUP, and the grader's death (``PR_SET_PDEATHSIG``) end the check as
     Ctrl-C would: its ``finally`` stops the test program and removes its folders."""
     import ctypes
     import signal
@@ -79,7 +79,7 @@ def _stop_as_ctrl_c() -> None:
 
 if __name__ == "__main__":
     _stop_as_ctrl_c()
-    problem = probe_launch(*sys.argv[1:2])  # type: ignore[arg-type]
+    problem = check_launch(*sys.argv[1:2])  # type: ignore[arg-type]
     if problem is not None:
         print(problem)
         sys.exit(1)

@@ -1,6 +1,6 @@
 """The timer_sync run and what is measured on it, in simulation time.
 
-The world holds each clock tick until the student's process is quiescent, but under load
+The world holds each clock tick until the student's process is done with it, but under load
 the probe may receive a message a tick or two late; so the streams are stamped with the
 sim time they were *published* at (the tick in force when the student sent them, from
 the DDS source timestamp).  A healthy 10 Hz timer then shows gaps of 0.1 s; a node one

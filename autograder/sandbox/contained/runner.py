@@ -1,14 +1,11 @@
 """How a student's program is run, once contained: as ``python SCRIPT ARGS...`` runs it,
 with one difference, the interpreter's thread switch interval (:data:`SWITCH_INTERVAL`).
 
-CPython lets a thread keep the GIL for 5 ms while another waits for it.  Jazzy's
-``MultiThreadedExecutor`` (rclpy 7.1) spins while a callback it handed to a worker thread
-has not started (ros2/rclpy#1452, fixed after Jazzy by ros2/rclpy#1547), and the worker
-needs the GIL the spinning thread keeps: each handover could cost a spin of 5 ms.  The
-world holds simulation time for a busy program only up to a CPU share (``sim.pacing``), so
-such spins decided whether a correct multithreaded design kept its points, and the answer
-changed with how much CPU the grader itself used.  At 0.5 ms a waiting thread gets the GIL
-ten times sooner; a program with one Python thread never notices.
+The shorter interval hands the GIL to a waiting thread sooner, so Jazzy's
+``MultiThreadedExecutor``, which spins until its worker thread takes a callback, does not
+spend the CPU share the world paces it by on that wait; a program with one Python thread
+never notices (why and what was measured: docs/contributors/design.md, "How a hold looks,
+and the GIL").
 
 The zygote calls :func:`run_program` in its forked child; a program that is exec'd runs
 this module's source through ``python -c`` (:func:`command`), since the student's user may

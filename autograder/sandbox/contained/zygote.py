@@ -1,6 +1,6 @@
 """A warm start for students' programs: a process that has imported rclpy once and forks
-each program from there, so a launch skips Python's start and the imports (about 0.3
-CPU-seconds of the 0.45 an rclpy program spends before its node exists).
+each program from there, so a launch skips Python's start and the imports, most of what an
+rclpy program spends before its node exists (docs/contributors/design.md, "Warm starts").
 
     python -s -m autograder.sandbox.contained.zygote FD
 

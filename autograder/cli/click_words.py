@@ -2,9 +2,9 @@
 
 click translates what it prints (``Error:``, ``Usage:``, "Missing argument", "No such
 option") with the standard library's ``gettext``, which knows nothing of our catalogs, so
-an Urdu run's usage errors came out in English.  :func:`speak` points the ``_`` and
-``ngettext`` of click's modules at ours; a string our catalog lacks stays click's English,
-as before.  The strings below are click's own, marked here so that extraction puts them in
+an Urdu run's usage errors would be English.  :func:`speak` points the ``_`` and
+``ngettext`` of click's modules at ours; a string our catalog lacks stays click's English.
+The strings below are click's own, marked here so that extraction puts them in
 ``messages.pot`` (those of a usage error; click's help pages keep the commands' English
 docstrings, so their headings stay English too).
 """
@@ -40,7 +40,8 @@ WORDS = (
 
 
 def speak() -> None:
-    """Make click translate with our catalogs (idempotent; English is unchanged)."""
+    """Make click translate with our catalogs, in whatever language is active when it
+    speaks (idempotent; English is unchanged)."""
     for module in _MODULES:
         module._ = _  # type: ignore[attr-defined]
         if hasattr(module, "ngettext"):
