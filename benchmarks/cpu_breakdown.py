@@ -28,7 +28,6 @@ from __future__ import annotations
 import argparse
 import collections
 import json
-import os
 import re
 import statistics
 import subprocess
@@ -40,6 +39,7 @@ from pathlib import Path
 from autograder.core.exercise import find_exercise, list_exercises
 
 PERIOD_NS = 4_000_000  # one sample per 4 ms of a thread's CPU time
+_PLUGIN = "-p benchmarks.threadnames"
 _FORK = re.compile(r"PERF_RECORD_FORK\((\d+):(\d+)\):\((\d+):(\d+)\)")
 _LINE = re.compile(r"^\s*(.*?)\s+(\d+)/(\d+)\s+(.*)$")
 _DDS = re.compile(r"^dds\.([a-z]+)")
@@ -49,8 +49,13 @@ def _inner(exercise_id: str, module_jobs: str) -> None:
     """The grading itself, in the process ``perf`` watches: its score and wall as JSON."""
     import resource
 
+    from autograder.grading import children
     from autograder.grading.run import grade
 
+    # The grader keeps the caller's pytest settings from its child pytests; this process
+    # only measures, and gives them the plugin that names their threads.
+    scrubbed = children.pytest_env
+    children.pytest_env = lambda env: {**scrubbed(env), "PYTEST_ADDOPTS": _PLUGIN}
     began = time.monotonic()
     result = grade(find_exercise(exercise_id), None,
                    module_jobs=module_jobs if module_jobs == "auto" else int(module_jobs))
@@ -129,11 +134,9 @@ def measure(exercise_id: str, workdir: Path, module_jobs: str = "auto",
             ) -> tuple[dict[str, float], dict[str, float | str]]:
     """One grading under ``perf``: its rows and its score, wall and rusage CPU."""
     data = workdir / "perf.data"
-    env = {**os.environ, "PYTEST_ADDOPTS": (os.environ.get("PYTEST_ADDOPTS", "")
-                                            + " -p benchmarks.threadnames").strip()}
     done = subprocess.run(["perf", "record", "-q", "-e", "task-clock", "-c", str(PERIOD_NS),
                            "-o", str(data), "--", sys.executable, __file__, "--inner",
-                           exercise_id, "--module-jobs", module_jobs], env=env,
+                           exercise_id, "--module-jobs", module_jobs],
                           capture_output=True, text=True, check=True)
     summary = json.loads(done.stdout.strip().splitlines()[-1])
     script = subprocess.run(["perf", "script", "-i", str(data), "--show-task-events",

@@ -150,10 +150,11 @@ def test_stays_alive(run, student):
 
 
 def _blind(run: Run, t: float) -> bool:
-    """Whether sim time ``t`` fell in a dropout after the robot should have stopped: a
-    robot that hits something then drove on blind, which test_stops_during_dropout
-    judges (a robot that stops in time cannot touch anything there)."""
-    return any(d.start + STOP_WITHIN <= t <= d.end for d in run.dropouts)
+    """Whether sim time ``t`` fell in a dropout after the robot should have stopped, or
+    within the same STOP_WITHIN after the scans came back (the least time a node needs to
+    react to the first one): a robot that hits something then drove on blind, which
+    test_stops_during_dropout judges (a robot that stopped in time is still there)."""
+    return any(d.start + STOP_WITHIN <= t <= d.end + STOP_WITHIN for d in run.dropouts)
 
 
 @pytest.mark.points(2)
@@ -189,7 +190,8 @@ def test_stops_during_dropout(run, world, student):
         cycles = (d.end - d.start - STOP_WITHIN) * 10
         if moving or going:
             first = moving[0] if moving else None
-            hit = next((c for c in collisions if d.start <= c.t <= d.end), None)
+            hit = next((c for c in collisions if d.start <= c.t <= d.end + STOP_WITHIN),
+                       None)
             message = _("The lidar went silent {start:.1f} s into the run; {after:.2f} s "
                         "later the robot still moved ({how}).").format(
                 start=d.start - run.start,
