@@ -181,9 +181,11 @@ def warm_start(python: str, env: dict[str, str]) -> Any:
 def close_zygotes() -> None:
     """End this process's zygotes and wait for them (at exit): the CPU time of the programs
     they forked then counts in this process's children's, as an exec'd program's does, for
-    whoever measures a grading's CPU (``grade-batch --jobs auto``, the benchmarks)."""
+    whoever measures a grading's CPU (``grade-batch --jobs auto``, the benchmarks). A later
+    launch starts a new one."""
     with _zygotes_lock:
         zygotes = list(_zygotes.values())
+        _zygotes.clear()
     for zygote in zygotes:
         zygote.close()
 

@@ -32,6 +32,7 @@ def run_program(script: str, args: list[str]) -> None:
     death by SIGINT once threads and exit handlers are done); any other exception prints
     its traceback (the student's frames only) and exits with status 1."""
     sys.setswitchinterval(SWITCH_INTERVAL)
+    fresh_signals()
     sys.argv = [script, *args]
     sys.path[0] = os.path.dirname(script)
     main = types.ModuleType("__main__")
@@ -50,6 +51,23 @@ def run_program(script: str, args: list[str]) -> None:
         if not isinstance(exc, KeyboardInterrupt):
             sys.exit(1)
         _exit_by_sigint()
+
+
+def fresh_signals() -> None:
+    """The signals as ``python script.py`` from a terminal has them, whoever started the
+    grader: none blocked, SIGINT raising KeyboardInterrupt, SIGPIPE and SIGXFSZ ignored
+    (CPython's own start-up), every other one at its default. A grader started in the background
+    (``cmd &``, some CI runners) has SIGINT ignored, and fork and exec pass that on: the
+    student's node then never saw its Ctrl-C and lost the shutdown tests."""
+    signal.pthread_sigmask(signal.SIG_SETMASK, [])
+    for number in signal.valid_signals():
+        if number in (signal.SIGKILL, signal.SIGSTOP):
+            continue
+        with contextlib.suppress(OSError, ValueError):
+            signal.signal(number, signal.SIG_DFL)
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    signal.signal(signal.SIGPIPE, signal.SIG_IGN)
+    signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
 
 
 def _exit_by_sigint() -> None:

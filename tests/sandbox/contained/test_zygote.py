@@ -19,7 +19,12 @@ import pytest
 from autograder.core.exercise import Limits
 from autograder.sandbox import process as process_module
 from autograder.sandbox.contained.zygote import ForkedProcess
-from autograder.sandbox.process import LaunchFailed, StudentProcess, student_process
+from autograder.sandbox.process import (
+    LaunchFailed,
+    StudentProcess,
+    close_zygotes,
+    student_process,
+)
 
 ROOT = Path(__file__).resolve().parents[3]
 # Wall seconds a program may take to start or to end: generous, for a loaded machine (a
@@ -94,6 +99,26 @@ def test_a_forked_program_ends_as_an_execd_one(name: str, tmp_path: Path,
         assert "prog.py" in forked_output
         for ours in ("zygote", "runner", "<string>"):
             assert ours not in forked_output and ours not in execd_output
+
+
+def test_a_program_gets_its_ctrl_c_however_the_grader_was_started(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A grader started in the background (``cmd &``, some CI runners) has SIGINT ignored,
+    maybe signals blocked, and passes both on through fork and exec: the student's program
+    still starts with them as a terminal gives them, forked or exec'd."""
+    close_zygotes()  # a zygote started earlier has this process's dispositions of then
+    old = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.pthread_sigmask(signal.SIG_BLOCK, [signal.SIGTERM])
+    try:
+        for forked in (False, True):
+            status, output, _program = _run(tmp_path / str(forked), "interrupted", forked,
+                                            monkeypatch)
+            assert status == -signal.SIGINT, (forked, output)
+            assert "KeyboardInterrupt" in output
+    finally:
+        signal.signal(signal.SIGINT, old)
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, [signal.SIGTERM])
+        close_zygotes()
 
 
 def test_a_failure_before_the_program_is_the_launchers_either_way(
