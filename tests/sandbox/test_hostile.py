@@ -6,6 +6,7 @@ course, so the whole corpus grades in about a minute."""
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import re
@@ -15,6 +16,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
@@ -49,6 +51,19 @@ def course():
         os.environ["AUTOGRADER_COURSE"] = old
 
 
+def _remove_stale_targets(ip: Callable[..., None]) -> None:
+    """A run killed before its teardown leaves its namespace and its veth holding the
+    target's addresses, and the next run's target is then unreachable: remove those whose
+    test process is gone."""
+    listing = subprocess.run(["ip", "netns", "list"], capture_output=True, text=True).stdout
+    for name in re.findall(r"^agtarget(\d+)", listing, re.M):
+        if not Path(f"/proc/{name}").exists():
+            with contextlib.suppress(subprocess.CalledProcessError):
+                ip("link", "del", f"agh{name}")
+            with contextlib.suppress(subprocess.CalledProcessError):
+                ip("netns", "del", f"agtarget{name}")
+
+
 @pytest.fixture(scope="module")
 def target_host():
     """A TCP server in a network namespace of this test's own, reachable from the host."""
@@ -62,6 +77,7 @@ def target_host():
         subprocess.run(["ip", *args], check=True, capture_output=True)
 
     server = None
+    _remove_stale_targets(ip)
     try:
         ip("netns", "add", ns)
         ip("link", "add", host_if, "type", "veth", "peer", "name", peer_if)
