@@ -8,6 +8,7 @@ import os
 import random
 import re
 import shutil
+import signal
 import subprocess
 import sys
 from collections.abc import Callable, Iterator
@@ -17,6 +18,14 @@ from pathlib import Path
 from shapes import NOBODY, ordinary_user, world_readable_folder
 
 AS_NOBODY = os.geteuid() == 0 and all(map(shutil.which, ("unshare", "setpriv")))
+
+
+def as_a_terminal_starts_it() -> None:
+    """Ctrl-C and Ctrl-\\ at their defaults, as in a terminal (a ``preexec_fn``): a test
+    run from a shell's background job inherits them ignored, and so would the command,
+    which Ctrl-C could then not end."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+    signal.signal(signal.SIGQUIT, signal.SIG_DFL)
 
 
 def commands(block: str) -> list[str]:

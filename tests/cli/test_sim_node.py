@@ -16,6 +16,7 @@ from pathlib import Path
 
 import pytest
 from click.testing import CliRunner
+from pasted import as_a_terminal_starts_it
 
 from autograder.cli import main
 from autograder.commands.hand_run import exercise_world, node_exercise
@@ -119,7 +120,7 @@ def test_ctrl_c_stops_world_and_node_and_leaves_nothing(ros_domain: int) -> None
     run = subprocess.Popen(_command(ros_domain, "--node", str(NODES / "steady_driver.py"),
                                     "--param", "speed:=0.2"),
                            env=_env(), stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                           text=True)
+                           text=True, preexec_fn=as_a_terminal_starts_it)
     try:
         seen, found = _read_until(run.stdout, FIRST, WALL)
         assert found, seen

@@ -19,6 +19,7 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
+from pasted import as_a_terminal_starts_it
 
 REPO = Path(__file__).resolve().parents[2]
 NODES = REPO / "tests" / "fixtures" / "hand_node"
@@ -162,14 +163,6 @@ def assert_nothing_left(work: Work, output: str) -> None:
     processes, folders = left_behind(work)
     assert (processes, folders) == ([], []), (
         output + "\n".join(described(pid) for pid, _cwd in processes))
-
-
-def as_a_terminal_starts_it() -> None:
-    """Ctrl-C and Ctrl-\\ at their defaults, as in a terminal: a test run from a shell's
-    background job inherits them ignored, and so would the command, which Ctrl-C could
-    then not end."""
-    signal.signal(signal.SIGINT, signal.SIG_DFL)
-    signal.signal(signal.SIGQUIT, signal.SIG_DFL)
 
 
 def started(case: Case, work: Work, **popen: object) -> subprocess.Popen[bytes]:
