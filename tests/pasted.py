@@ -21,11 +21,11 @@ AS_NOBODY = os.geteuid() == 0 and all(map(shutil.which, ("unshare", "setpriv")))
 
 
 def as_a_terminal_starts_it() -> None:
-    """Ctrl-C and Ctrl-\\ at their defaults, as in a terminal (a ``preexec_fn``): a test
-    run from a shell's background job inherits them ignored, and so would the command,
-    which Ctrl-C could then not end."""
-    signal.signal(signal.SIGINT, signal.SIG_DFL)
-    signal.signal(signal.SIGQUIT, signal.SIG_DFL)
+    """Ctrl-C, Ctrl-\\, hang-up and termination at their defaults, as in a terminal (a
+    ``preexec_fn``): a test run from a shell's background job inherits SIGINT and SIGQUIT
+    ignored, one run under ``nohup`` SIGHUP, and so would the command it starts."""
+    for signum in (signal.SIGINT, signal.SIGQUIT, signal.SIGHUP, signal.SIGTERM):
+        signal.signal(signum, signal.SIG_DFL)
 
 
 def commands(block: str) -> list[str]:

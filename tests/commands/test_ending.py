@@ -224,7 +224,7 @@ def test_a_killed_parent_ends_the_command_and_leaves_nothing(name: str, work: Wo
     shell = subprocess.Popen(  # `; true`: the shell waits for the command, as a terminal's
         ["bash", "-c", 'cd "$1" && shift && "$@" > out.txt 2>&1; true', "shell",
          str(work.folder), *work.command(case.args(work))],
-        env=work.env(), start_new_session=True)
+        env=work.env(), start_new_session=True, preexec_fn=as_a_terminal_starts_it)
     try:
         children = Path(f"/proc/{shell.pid}/task/{shell.pid}/children")
         wait_for(lambda: log.exists() and children.read_text().split(), WALL, "the command")
@@ -315,11 +315,12 @@ def test_nohup_and_setsid_keep_a_command_past_its_parent() -> None:
              "print(inside, now())\n")
     env = {**os.environ, "PYTHONPATH": str(REPO)}
     plain = subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True,
-                           text=True, check=True)
+                           text=True, check=True, preexec_fn=as_a_terminal_starts_it)
     assert plain.stdout.split() == [str(int(signal.SIGHUP)), "0"]
     for prefix in (["nohup"], ["setsid", "--wait"]):
         kept = subprocess.run([*prefix, sys.executable, "-c", probe], env=env,
-                              capture_output=True, text=True, check=True)
+                              capture_output=True, text=True, check=True,
+                              preexec_fn=as_a_terminal_starts_it)
         assert kept.stdout.split() == ["0", "0"], prefix
 
 
@@ -373,5 +374,6 @@ def test_signals_while_it_cleans_up_do_not_cut_the_cleanup_short() -> None:
              "        print('cleaned up after', stop.name)\n"
              "    print('exit', state.exit_status(0))\n")
     done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
-                          env={**os.environ, "PYTHONPATH": str(REPO)}, timeout=60)
+                          env={**os.environ, "PYTHONPATH": str(REPO)}, timeout=60,
+                          preexec_fn=as_a_terminal_starts_it)
     assert done.stdout.splitlines() == ["cleaned up after SIGHUP", "exit 129"], done.stderr
