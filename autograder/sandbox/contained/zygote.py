@@ -34,6 +34,7 @@ import subprocess
 import sys
 import threading
 from collections.abc import Callable, Mapping, Sequence
+from typing import Any
 
 from autograder.sandbox.contained.launcher import LAUNCH_FAILED, contain
 from autograder.sandbox.contained.runner import run_program
@@ -88,53 +89,84 @@ def serve(fd: int) -> tuple[str, list[str]]:
                 _reap(sock)
                 os._exit(0)
             request = json.loads(data)
+
+            def in_child(keep: Sequence[int] = fds) -> None:
+                signal.set_wakeup_fd(-1)
+                signal.signal(signal.SIGCHLD, signal.SIG_DFL)
+                sock.detach()  # its descriptor is closed below, with the wake pipe's
+                _close_all_but(keep)
+
             try:
-                pid = fork()
+                pid = fork(in_child)
             except OSError as exc:  # no process to be had: the grader execs this one
                 for passed in fds:
                     os.close(passed)
                 _send(sock, {"error": f"fork: {exc}"})
                 continue
             if pid == 0:
-                signal.set_wakeup_fd(-1)
-                signal.signal(signal.SIGCHLD, signal.SIG_DFL)
-                for own in (sock.detach(), wake_read, wake_write):
-                    os.close(own)
                 return _become_program(request, fds)
             for passed in fds:
                 os.close(passed)
             _send(sock, {"pid": pid})
 
 
-def _fork_with_hooks() -> Callable[[], int]:
-    """``os.fork`` wrapped in the fork hooks of every LTTng-UST copy loaded (rclpy's
-    wheels bundle it for ROS 2 tracing; its constructor starts two listener threads).
-    Without them a forked child dies of SIGSEGV at exit, when LTTng cancels threads
-    that only its parent has: the protocol of LTTng's own ``liblttng-ust-fork``."""
+ForkHook = tuple[Callable[[Any], Any], Callable[[Any], Any], Callable[[Any], Any], Any]
+
+
+def _lttng_hooks() -> list[ForkHook]:
+    """The fork hooks (before, after in the parent, after in the child, their saved
+    state) of every LTTng-UST copy loaded: rclpy's wheels bundle it for ROS 2 tracing."""
     import ctypes
 
     with open("/proc/self/maps") as maps:
         paths = sorted({line.split()[-1] for line in maps
                         if "/liblttng-ust-" in line and "tracepoint" not in line})
-    hooks = []
+    hooks: list[ForkHook] = []
     for path in paths:
         with contextlib.suppress(OSError, AttributeError):
             lib = ctypes.CDLL(path)
             hooks.append((lib.ust_before_fork, lib.ust_after_fork_parent,
                           lib.ust_after_fork_child, ctypes.create_string_buffer(1024)))
+    return hooks
 
-    def fork() -> int:
+
+def _fork_with_hooks(hooks: Sequence[ForkHook] | None = None,
+                     ) -> Callable[[Callable[[], None]], int]:
+    """``os.fork`` wrapped in LTTng's fork hooks, the protocol of LTTng's own
+    ``liblttng-ust-fork``: without them a forked child dies of SIGSEGV at exit, when LTTng
+    cancels threads that only its parent has.
+
+    ``fork(in_child)`` runs ``in_child`` in the child before the child's hook, which
+    starts LTTng's listener threads again; those open and close sockets and shared-memory
+    files at once, so descriptors must be closed before they exist.  Closed afterwards, a
+    listener's descriptor number went to the student's cgroup file and the listener's own
+    close took it away ("the launcher failed at cgroup: Bad file descriptor", seen in CI)."""
+    hooks = _lttng_hooks() if hooks is None else list(hooks)
+
+    def fork(in_child: Callable[[], None]) -> int:
         for before, _parent, _child, saved in hooks:
             before(saved)  # takes LTTng's locks and blocks signals until the after hook
         pid = -1
         try:
             pid = os.fork()
+            if pid == 0:
+                in_child()
         finally:
             for _before, parent, child, saved in reversed(hooks):
                 (child if pid == 0 else parent)(saved)
         return pid
 
     return fork
+
+
+def _close_all_but(keep: Sequence[int]) -> None:
+    """Close every descriptor above stderr but those in ``keep``."""
+    low = 3
+    for fd in sorted(set(keep)):
+        if fd >= low:
+            os.closerange(low, fd)
+            low = fd + 1
+    os.closerange(low, os.sysconf("SC_OPEN_MAX"))
 
 
 def _reap(sock: socket.socket) -> None:
@@ -162,16 +194,20 @@ def _receive(sock: socket.socket) -> tuple[bytes, list[int]]:
 
 
 def _become_program(request: dict, fds: list[int]) -> tuple[str, list[str]]:
-    """In the forked child: what the launcher does up to its exec, reporting a failure on
-    the status pipe as it does; then the pipe is closed, as an exec would close it."""
+    """In the forked child, whose other descriptors are closed: what the launcher does up
+    to its exec, reporting a failure on the status pipe as it does; then the pipe is
+    closed, as an exec would close it.  Only descriptors opened here are closed here:
+    LTTng's threads run again and own the others."""
     output, status = fds
     os.setsid()
     null = os.open(os.devnull, os.O_RDONLY)
     os.dup2(null, 0)
+    if null != 0:
+        os.close(null)
     for target in (1, 2):
         os.dup2(output, target)
-    os.closerange(3, status)
-    os.closerange(status + 1, os.sysconf("SC_OPEN_MAX"))
+    if output not in (0, 1, 2):
+        os.close(output)
     stage = ["environment"]
     try:
         os.environ.clear()

@@ -204,3 +204,42 @@ def test_a_zygote_that_cannot_start_costs_only_its_own_launches(
         finally:
             program.stop()
         assert program.output_text() == "ran\n"
+
+
+def test_the_zygotes_descriptors_are_closed_before_lttngs_threads_start_again(
+        tmp_path: Path) -> None:
+    """In the forked child, LTTng's after-fork hook starts listener threads that open
+    sockets at once.  The zygote's descriptors are closed before that hook runs, so nothing
+    the hook opens is closed behind its back (CI once saw a listener's close take the
+    student's cgroup file: "the launcher failed at cgroup: Bad file descriptor")."""
+    from autograder.sandbox.contained.zygote import _close_all_but, _fork_with_hooks
+
+    report_read, report_write = os.pipe()
+    leftover = os.open(tmp_path, os.O_RDONLY)  # a descriptor of the zygote's own
+    opened: list[int] = []
+
+    def child_hook(_saved: object) -> None:  # what LTTng's listener threads do
+        opened.append(os.open(os.devnull, os.O_RDONLY))
+
+    def nothing(_saved: object) -> None:
+        return None
+
+    fork = _fork_with_hooks([(nothing, nothing, child_hook, None)])
+    pid = fork(lambda: _close_all_but([report_write]))
+    if pid == 0:
+        def is_open(fd: int) -> bool:
+            try:
+                os.fstat(fd)
+            except OSError:
+                return False
+            return True
+        os.write(report_write, f"{is_open(opened[0])} {is_open(leftover)}".encode())
+        os._exit(0)
+    os.close(report_write)
+    os.close(leftover)
+    try:
+        report = os.read(report_read, 100).decode()
+    finally:
+        os.close(report_read)
+        os.waitpid(pid, 0)
+    assert report == "True False", "the hook's descriptor, then the zygote's leftover"
