@@ -89,7 +89,7 @@ class SimBridge:
 
     def __init__(self, world: World, context: Context, *, real_time_factor: float = 1.0,
                  policy: PacingPolicy | None = None, node_name: str = "sim_world",
-                 cmd_vel_type: CmdVelType | None = None) -> None:
+                 cmd_vel_type: CmdVelType | None = None, gated: bool = False) -> None:
         self.sim = Simulation(world)
         self.cmd_vel_type: CmdVelType = cmd_vel_type or world.spec.cmd_vel_type
         self.world = world
@@ -97,8 +97,10 @@ class SimBridge:
         # Before the node: bad settings (a negative RTF, no clock rate) raise ValueError here.
         # A hold for the student's node ends once our middleware has taken in what it sent.
         self._receiving = Receiving()
+        # gated: sim time stays at 0 until a wait for sim time (or for a node to come up)
+        # opens the gate, however long the grader takes to set a module up.
         self.pacer = Pacer(world.dt, real_time_factor, policy, receiving=self._receiving,
-                           delivering=lambda: backlog() > 0)
+                           delivering=lambda: backlog() > 0, gated=gated)
         self._cond = self.pacer.condition
         self._cmd: tuple[float, float] | None = None
         # Commands taken in a later tick than the one they were sent in, and the most sim
@@ -302,8 +304,14 @@ class SimBridge:
         return mismatches(self.node, {CMD_VEL_TOPIC: full_name(self.cmd_vel_type)},
                           ignore=(self.node.get_name(),))
 
+    def clock_listeners(self) -> int:
+        """Subscriptions our /clock publisher has matched (the probe's among them)."""
+        return self._clock_pub.get_subscription_count()
+
     def wait_until(self, sim_time: float, wall_timeout: float) -> bool:
-        """Block until sim time reaches ``sim_time``; False if ``wall_timeout`` passes first."""
+        """Block until sim time reaches ``sim_time``; False if ``wall_timeout`` passes first.
+        A gated world's first wait opens its gate."""
+        self.pacer.open_gate()
         with self._timed_wait(), self._cond:
             return self._cond.wait_for(lambda: self.world.time >= sim_time - 1e-9,
                                        timeout=wall_timeout)
@@ -328,7 +336,9 @@ class SimBridge:
 
         The predicate is checked at every tick, and also every ``recheck`` wall seconds
         so that one watching another thread (a probe's messages) is seen while paused.
+        A gated world's first wait opens its gate: sim time is wanted from now on.
         """
+        self.pacer.open_gate()
         end = time.monotonic() + wall_timeout
         with self._timed_wait(), self._cond:
             limit = self.world.time + sim_timeout

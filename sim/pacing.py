@@ -32,6 +32,9 @@ design notes, "Pacing"):
   catching up), while a busy loop banks nothing.
 * **Held.**  Inside :meth:`Pacer.held` (a student's program starting) no tick goes;
   afterwards the schedule starts afresh from that moment.
+* **Gate.**  A pacer made with ``gated=True`` (a grading's world) sends no tick until
+  :meth:`Pacer.open_gate`: sim time stays at its start however long the machine takes
+  to set the module up, so the student's node meets the same clock on any machine.
 
 How each hold ended is counted (:attr:`Pacer.counts`: the results file's ``pacing``).
 The pacer's condition is the bridge's lock: a tick runs under it, so ``pause()`` returning
@@ -152,7 +155,8 @@ class Pacer:
                  read_process: ProcessReader = read_process_state,
                  receiving: Callable[[], bool] | None = None,
                  delivering: Callable[[], bool] | None = None,
-                 condition: threading.Condition | None = None) -> None:
+                 condition: threading.Condition | None = None,
+                 gated: bool = False) -> None:
         if real_time_factor < 0:
             raise ValueError("real_time_factor must be >= 0")
         self.dt = dt
@@ -169,6 +173,7 @@ class Pacer:
         self._adaptive_tick = 1.0 / self.policy.clock_hz
         self._running = True
         self._paused = False
+        self._gated = gated  # no tick until open_gate (see the module's "Gate")
         self._start: float | None = None  # wall time the coming tick's period began
         self._pids: set[int] = set()
         # (wall time, sim time) after each of the last ticks, for effective_rtf
@@ -205,6 +210,18 @@ class Pacer:
             self._paused = False
             self._window.clear()
             self.condition.notify_all()
+
+    @property
+    def gated(self) -> bool:
+        """No tick has been let go yet (see :meth:`open_gate`)."""
+        return self._gated
+
+    def open_gate(self) -> None:
+        """Let the ticks of a pacer made ``gated`` go (unless paused or held); once."""
+        with self.condition:
+            if self._gated:
+                self._gated = False
+                self.condition.notify_all()
 
     @contextlib.contextmanager
     def held(self) -> Iterator[None]:
@@ -313,8 +330,9 @@ class Pacer:
         with self.condition:
             if self._start is None:
                 self._start = self._clock.monotonic()
-            if self._running and self._paused:
-                self._clock.wait(self.condition, lambda: not (self._running and self._paused))
+            if self._running and (self._paused or self._gated):
+                self._clock.wait(self.condition, lambda: not (
+                    self._running and (self._paused or self._gated)))
                 self._start = self._clock.monotonic()  # the schedule starts afresh
             if not self._running:
                 return None

@@ -51,7 +51,8 @@ def node_endpoints(graph: Graph, name: str | None) -> dict[bytes, str]:
 
 def wait_until_up(world: HeldWorld, graph: Graph, name: str | None, stale: Iterable[bytes],
                   running: Callable[[], bool], timeout: float,
-                  waited: Callable[[], float] = lambda: 0.0) -> dict[bytes, str]:
+                  waited: Callable[[], float] = lambda: 0.0,
+                  listening: Callable[[], bool] | None = None) -> dict[bytes, str]:
     """Wait, with simulation time held, until node ``name`` (any node: None) has publishers
     not in ``stale``, the program stops ``running``, or ``timeout`` seconds pass (the
     start-up is the machine's business: imports, discovery). The new publishers, if any.
@@ -60,21 +61,30 @@ def wait_until_up(world: HeldWorld, graph: Graph, name: str | None, stale: Itera
     count, so a start-up's verdict does not depend on the load; a program starved for
     :data:`STARVED_FACTOR` times ``timeout`` raises :class:`Starved`, the grader's failure.
     A start-up thus costs the same simulation time on any machine, and the node's first
-    tick is the one after this returns."""
+    tick is the one after this returns.
+
+    With ``listening`` (whether the world's /clock has matched the node's subscription),
+    the hold goes on once the node is up until it holds, for at most LISTEN_GRACE of the
+    program's time: a tick sent before that match is lost to the node, whose clock would
+    then begin at a later tick, as late as the machine is slow."""
     started, waited_before = time.monotonic(), waited()
     cap = started + timeout * STARVED_FACTOR
     stale = set(stale)
     found: dict[bytes, str] = {}
     starved = False
+    up: float | None = None  # the program's time (not counting its waits) when it was up
 
     def ready() -> bool:
-        nonlocal found, starved
+        nonlocal found, starved, up
         found = {gid: node for gid, node in node_endpoints(graph, name).items()
                  if gid not in stale}
         now = time.monotonic()
         starved = now > cap
-        return bool(found) or not running() or starved \
-            or now - started - (waited() - waited_before) > timeout
+        took = now - started - (waited() - waited_before)
+        if found and listening is not None and running() and not starved:
+            up = took if up is None else up
+            return listening() or took - up > LISTEN_GRACE
+        return bool(found) or not running() or starved or took > timeout
 
     with world.held():
         world.wait_for(ready, sim_timeout=math.inf, wall_timeout=timeout * STARVED_FACTOR + 1)
@@ -86,6 +96,10 @@ def wait_until_up(world: HeldWorld, graph: Graph, name: str | None, stale: Itera
 STARVED_FACTOR = 4
 """A start-up may take this many times its timeout in wall time while the machine keeps
 the program waiting for a CPU."""
+LISTEN_GRACE = 2.0
+"""Seconds of the program's own time (not its waits for a CPU) that a node found on the graph
+is given for its /clock subscription to match the world's publisher: the two are announced
+together, so only a node that never listens to /clock (use_sim_time set false) waits it out."""
 
 
 class Starved(GraderError):

@@ -154,6 +154,7 @@ def _launch(request: pytest.FixtureRequest, exercise: Exercise, script: Path, pr
     # lease runs out, some of its endpoints too. Only publishers that were not there
     # before the start are this instance's.
     stale = _node_endpoints(probe, exercise.node) if wait_for_node else set()
+    listeners = world.clock_listeners()  # /clock's subscriptions before this instance's
     reporter = request.config.stash.get(reporter_key, None)
     if reporter is not None:
         process.on_spawn = lambda: reporter.note_process(
@@ -173,7 +174,7 @@ def _launch(request: pytest.FixtureRequest, exercise: Exercise, script: Path, pr
             node.stop()
             raise StudentFailure(earlier.message, earlier.hint)
         try:
-            _wait_for_node(exercise, node, world, stale)
+            _wait_for_node(exercise, node, world, stale, listeners)
         except NodeNeverAppeared as failure:  # stopped already
             request.config.stash[startup_key] = failure
             raise
@@ -212,13 +213,18 @@ def _node_endpoints(probe: Probe, name: str) -> set[bytes]:
 
 
 def _wait_for_node(exercise: Exercise, node: StudentNode, world: SimBridge,
-                   stale: set[bytes]) -> None:
-    """Wait, with simulation time held, until this instance's node is on the graph: a
-    start-up is then the same in simulation time however long the machine takes (imports,
-    discovery), and the node's first tick is the next one."""
+                   stale: set[bytes], listeners: int | None = None) -> None:
+    """Wait, with simulation time held, until this instance's node is on the graph and the
+    world's /clock reaches it (``listeners``: /clock's subscriptions before the start; None:
+    not waited for): a start-up is then the same in simulation time however long the
+    machine takes (imports, discovery), and the node's first tick is the next one.  A
+    grading's world holds sim time from the module's start (its gate), so the node's clock
+    begins at the same sim time on any machine."""
     pid = node.process.pid
     found = wait_until_up(world, node.probe.node, exercise.node, stale, node.running,
-                          exercise.startup_timeout, lambda: runqueue_wait_ns(pid) / 1e9)
+                          exercise.startup_timeout, lambda: runqueue_wait_ns(pid) / 1e9,
+                          None if listeners is None else
+                          lambda: world.clock_listeners() > listeners)
     if found:
         node.startup_seconds = time.monotonic() - node.process.started_at
         node.appeared_at = world.now

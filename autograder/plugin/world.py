@@ -85,7 +85,8 @@ def ros_context(pytestconfig: pytest.Config) -> Iterator[Context]:
 @pytest.fixture(scope="module")
 def world(request: pytest.FixtureRequest, exercise: Exercise,
           ros_context: Context) -> Iterator[SimBridge]:
-    """The simulated world, running, for this test module (``@pytest.mark.world`` picks it)."""
+    """The simulated world for this test module (``@pytest.mark.world`` picks it), its sim
+    time held at 0 until the student's node is up or a test first waits for sim time."""
     from sim.worldfile import load_world
 
     marker = request.node.get_closest_marker("world")
@@ -138,7 +139,10 @@ def _make_world(exercise: Exercise, spec: WorldSpec, ros_context: Context,
                      policy=PacingPolicy(clock_hz=exercise.clock_hz,
                                          cpu_budget=exercise.cpu_budget),
                      real_time_factor=exercise.real_time_factor if rtf is None else rtf,
-                     cmd_vel_type=exercise.cmd_vel_type)
+                     cmd_vel_type=exercise.cmd_vel_type,
+                     # Sim time stays at 0 while the module sets up (probe, student's
+                     # program): the node's clock begins there on any machine.
+                     gated=True)
 
 
 def _wire(settings: RunSettings) -> Wire | None:

@@ -33,9 +33,10 @@ PLAN_TOLERANCE = 0.25
 # grading.
 # The node's timers begin when its clock does: at sim time 0 if it made them before its
 # first /clock (ROS time reads 0 until then), at the latest when it appeared on the graph
-# (``Streams.started``; sim time stands still while it starts).  On a loaded machine the
-# world may be 1-2 s old by then, so its planner runs from 10 to 12 s of a clock that
-# began anywhere in between.  The public run therefore goes at half pace from SWITCH_AT of
+# (``Streams.started``).  A grading's world holds sim time at 0 from the module's start
+# until the node is up and hears /clock (plugin/student.py), so both are 0 on any machine;
+# the window still allows a clock begun up to ``started``, as a hand-started world may
+# have run before.  The public run therefore goes at half pace from SWITCH_AT of
 # sim time (the earliest such clock's first run still has 0.25 s to go) and closes END_AT
 # after the node appeared (the latest clock's first plan is in): 12.25 s in all, at least
 # 0.5 s of it at half pace.  That shows a wall-clock node's doubled rate (10 commands
