@@ -57,7 +57,7 @@ from sim.faults import Scan
 from sim.msgdefs import type_name
 from sim.pacing import HoldOutcome, Pacer, PacingPolicy
 from sim.physics import World
-from sim.procstate import Receiving, backlog
+from sim.procstate import Receiving, backlog, read_process_state, runqueue_wait_ns
 from sim.recorder import Recording, Sample
 from sim.worldfile import CmdVelType, Fault
 
@@ -253,6 +253,15 @@ class SimBridge:
     def unwatch_pid(self, pid: int) -> None:
         """Stop watching process ``pid``."""
         self.pacer.unwatch(pid)
+
+    def watched_usage(self) -> tuple[int, int]:
+        """CPU ns the watched processes have used, and ns they have waited for a CPU, so
+        far (summed): whether the node or the machine kept sim time back."""
+        cpu = wait = 0
+        for pid in self.pacer.watched:
+            cpu += read_process_state(pid).cpu_ns
+            wait += runqueue_wait_ns(pid)
+        return cpu, wait
 
     # -- observing ------------------------------------------------------------------
     @property

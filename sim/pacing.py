@@ -268,6 +268,12 @@ class Pacer:
                 self._reserve.setdefault(pid, 0.0)
             self._window.clear()
 
+    @property
+    def watched(self) -> tuple[int, ...]:
+        """The processes ticks are held for."""
+        with self.condition:
+            return tuple(self._pids)
+
     def unwatch(self, pid: int) -> None:
         with self.condition:
             self._pids.discard(pid)

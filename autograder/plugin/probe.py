@@ -133,6 +133,23 @@ class Inbox(Generic[M]):
             self._sent.clear()
 
 
+def kept_busy(before: tuple[int, int], after: tuple[int, int], wall: float) -> bool:
+    """Whether the watched processes (the student's node) kept the machine busy over
+    ``wall`` seconds, from their (CPU ns, ns waited for a CPU) ``before`` and ``after``:
+    they ran for a quarter of it and at least half of the time they were not kept
+    waiting, and a CPU-second or more.  A busy loop runs whenever it is let (a third of a
+    core or more beside two busy loops and the grader on two cores); a node that only
+    reacts to ticks runs for a small part of it, however busy the rest of the machine
+    is, and when the world stalls few ticks come.  Below that the machine is to blame."""
+    cpu = (after[0] - before[0]) / 1e9
+    waited = (after[1] - before[1]) / 1e9
+    return cpu >= max(BUSY_CPU_SECONDS, 0.25 * wall, 0.5 * (wall - waited))
+
+
+BUSY_CPU_SECONDS = 1.0
+"""The least CPU a node must have used in a stalled wait to be what stalled it."""
+
+
 class Probe:
     """A node in the grader's process, on the same graph as the student's node."""
 
@@ -196,7 +213,9 @@ class Probe:
         """True once ``condition()`` holds, False when ``sim_timeout`` of sim time passed.
 
         The wall cap (default: 4 times the sim timeout, at least 10 s) only ends waits on a
-        world that stopped advancing; it raises, as that is no verdict on the student.
+        world that stopped advancing; it raises, as that is no verdict on a sim-time
+        condition: the student's failure if its node kept the CPU busy meanwhile (the world
+        holds ticks for it), else the grader's (:func:`kept_busy`).
         """
         wall = wall_timeout if wall_timeout is not None else max(10.0, 4.0 * sim_timeout)
         start = self.now
@@ -206,11 +225,20 @@ class Probe:
 
         if condition():
             return True
+        usage = getattr(self.world, "watched_usage", None)
+        before, began = (usage() if usage else None), time.monotonic()
         done = self.world.wait_for(lambda: condition() or elapsed(),
                                    sim_timeout=sim_timeout, wall_timeout=wall)
         if condition():
             return True
         if not done and not elapsed():
+            took = time.monotonic() - began
+            if before is not None and usage is not None and \
+                    not kept_busy(before, usage(), took):
+                raise GraderError(
+                    _("The simulation could not advance for {seconds:.0f} s of wall time, and "
+                      "the node was not what kept it busy: the machine was too busy to grade. "
+                      "Grade again on a quieter machine.").format(seconds=took))
             raise StudentFailure(
                 _("The simulation could not advance for {seconds:.0f} s of wall time: the "
                   "node kept the machine too busy.").format(seconds=wall),

@@ -1,0 +1,24 @@
+"""Whose failure a stalled wait is: the node's if it kept the CPU busy, else the machine's."""
+
+from autograder.plugin.probe import kept_busy
+
+S = 1_000_000_000  # ns
+
+
+def test_a_busy_loop_is_blamed_even_on_a_loaded_machine():
+    # 10 s of wall time: running 4 s, waiting for a CPU the other 6 (never asleep).
+    assert kept_busy((0, 0), (4 * S, 6 * S), 10.0)
+
+
+def test_an_idle_node_on_a_starved_machine_is_not_blamed():
+    # It ran 0.3 s and waited 2 s: the rest of the 10 s it slept, waiting for ticks.
+    assert not kept_busy((0, 0), (S * 3 // 10, 2 * S), 10.0)
+
+
+def test_a_node_kept_waiting_all_along_is_not_blamed():
+    # Four threads queued for a CPU for 9 s each: waits add up past the wall time.
+    assert not kept_busy((5 * S, 0), (5 * S + S // 2, 36 * S), 10.0)
+
+
+def test_nothing_watched_is_never_the_node():
+    assert not kept_busy((0, 0), (0, 0), 12.0)
