@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import re
+import time
 from collections.abc import Callable
 from typing import Any
 
@@ -63,6 +64,8 @@ class ScanFeeder:
     def __init__(self, probe: Any) -> None:
         self.probe = probe
         self.scan: LaserScan | None = None
+        # Wall time (epoch seconds, as DDS source timestamps) the last scan was sent by.
+        self.last_sent_wall: float | None = None
         probe.publish(LaserScan, "/scan", CLEAR)  # creates the publisher; nobody listens yet
         self.timer = probe.node.create_timer(0.1, self._tick)
 
@@ -71,6 +74,7 @@ class ScanFeeder:
         if scan is not None:
             scan.header.stamp = self.probe.node.get_clock().now().to_msg()
             self.probe.publish(LaserScan, "/scan", scan)
+            self.last_sent_wall = time.time()  # after the publish: the node got it later
 
     def feed(self, scan: LaserScan | None) -> float:
         """From now on publish ``scan`` (None: nothing); the simulation time it changed."""
