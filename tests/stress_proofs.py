@@ -4,7 +4,8 @@ and again, and check that each loses exactly its expected set every time.
 Not part of the suite (it takes minutes per exercise). Each round grades every chosen
 variant (two at a time, as ``grade-batch --jobs 2`` does on a 2-core machine) while
 ``--busy`` processes spin ``while True: pass``; a variant passes when every round lost
-exactly its ``loses`` and its feedback fits ``says`` and ``not_says``::
+exactly its ``loses``, its feedback fits ``says`` and ``not_says``, and it got the same
+score as in its first round, test by test (one submission, one score)::
 
     python tests/stress_proofs.py                          # every exercise, every known-bad
     python tests/stress_proofs.py timer_sync callback_groups:shared_group,deadlock
@@ -81,6 +82,23 @@ def _difference(result: RunResult | BaseException, variant: Variant) -> str | No
     return "; ".join(parts) or None
 
 
+def _scores(result: RunResult | BaseException) -> dict[str, str] | None:
+    """Each test's score, as the report gives it (None: no result to compare)."""
+    if isinstance(result, BaseException) or result.grader_error is not None:
+        return None
+    return {t.name: str(t.score) for t in result.tests}
+
+
+def _score_difference(first: dict[str, str] | None, now: dict[str, str] | None) -> str | None:
+    """How a round's scores differ from the first round's (None: the same, or no pair)."""
+    if first is None or now is None or first == now:
+        return None
+    changed = sorted(name for name in first.keys() | now.keys()
+                     if first.get(name) != now.get(name))
+    return "scores differ from round 1: " + ", ".join(
+        f"{name} {first.get(name)} -> {now.get(name)}" for name in changed)
+
+
 def _paced(result: RunResult) -> str:
     """How the world held its ticks in each module, where it was not simply for an idle
     node: which way a lost test's sim time may have run ahead of the node."""
@@ -118,6 +136,7 @@ def main(argv: list[str]) -> int:
           f"beside {args.busy} busy loops", flush=True)
     exact: Counter[str] = Counter()
     differences: dict[str, list[str]] = {}
+    first_scores: dict[str, dict[str, str] | None] = {}
     busy = [subprocess.Popen([sys.executable, "-c", BUSY]) for _ in range(args.busy)]
     started = time.monotonic()
     try:
@@ -127,6 +146,12 @@ def main(argv: list[str]) -> int:
                 for (exercise_id, variant), result in zip(chosen, results, strict=True):
                     key = f"{exercise_id}/{variant.name}"
                     difference = _difference(result, variant)
+                    scores = _scores(result)
+                    if first_scores.get(key) is None:
+                        first_scores[key] = scores
+                    changed = _score_difference(first_scores[key], scores)
+                    if changed is not None:
+                        difference = f"{difference}; {changed}" if difference else changed
                     if difference is None:
                         exact[key] += 1
                     else:
