@@ -130,7 +130,13 @@ def fly(world: Any, probe: Any, student: Any, limit: float) -> Mission:
 
 
 def judge_reached(mission: Mission, credit: Any, world_name: str) -> None:
-    """Full marks for stopping at the goal untouched; else the share of the way covered."""
+    """Full marks for stopping at the goal untouched; nothing for a run that touched
+    something; else the share of the way covered.
+
+    A hit earns nothing: where on its way a drive meets an obstacle turns on small
+    differences in timing (an agent whose loop races its spinning thread clipped a pillar
+    at a slightly different place in each run), so a share of the way up to it gave the
+    same program scores that differed by hundredths from one grading to the next."""
     if mission.arrived_at is not None and mission.hit is None:
         return
     progress = mission.progress()
@@ -143,9 +149,11 @@ def judge_reached(mission: Mission, credit: Any, world_name: str) -> None:
         until = mission.died_at if mission.died_at is not None else math.inf
         message = with_front_beam_note(message, [hit], mission.samples, mission.geometry,
                                        since=mission.t0, until=until)
-        hint = _("Steer by the lidar: never drive toward a direction whose readings are "
-                 "closer than the robot needs to pass.")
-    elif mission.died_at is not None:
+        raise StudentFailure(message, _(
+            "Steer by the lidar: never drive toward a direction whose readings are closer "
+            "than the robot needs to pass. A run that touches something earns none of the "
+            "test's points."))
+    if mission.died_at is not None:
         message = _("In the {world}, the node's process ended after {seconds:.1f} s, having "
                     "covered {share:.0%} of the way. Its last lines:\n{tail}").format(
             world=world_name, seconds=mission.died_at - mission.t0, share=progress,
