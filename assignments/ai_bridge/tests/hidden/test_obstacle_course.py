@@ -12,12 +12,12 @@ pytestmark = [pytest.mark.world(WORLD),
 
 
 @pytest.mark.points(3)
-def test_obstacles_reaches_goal(mission, credit):
+def test_obstacles_reaches_goal(mission):
     """Obstacle course: the robot stops within 0.3 m of the goal, touching nothing"""
-    judge_reached(mission, credit, _("obstacle course"))
+    judge_reached(mission, _("obstacle course"))
 
 
 @pytest.mark.points(1)
-def test_obstacles_efficient_path(mission, credit):
+def test_obstacles_efficient_path(mission):
     """Obstacle course: the path is not much longer than the straight line (bonus)"""
-    judge_efficiency(mission, credit, _("obstacle course"))
+    judge_efficiency(mission, _("obstacle course"))

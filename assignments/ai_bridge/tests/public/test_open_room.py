@@ -20,9 +20,9 @@ pytestmark = [pytest.mark.world(WORLD),
 
 
 @pytest.mark.points(3)
-def test_open_room_reaches_goal(mission, credit):
+def test_open_room_reaches_goal(mission):
     """Open room: the robot stops within 0.3 m of the goal, touching nothing"""
-    judge_reached(mission, credit, _("open room"))
+    judge_reached(mission, _("open room"))
 
 
 @pytest.mark.points(2)
@@ -70,6 +70,6 @@ def test_open_room_reports_arrival(mission):
 
 
 @pytest.mark.points(1)
-def test_open_room_efficient_path(mission, credit):
+def test_open_room_efficient_path(mission):
     """Open room: the path is not much longer than the straight line (bonus)"""
-    judge_efficiency(mission, credit, _("open room"))
+    judge_efficiency(mission, _("open room"))
