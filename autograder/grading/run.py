@@ -109,7 +109,7 @@ def _grade_once(exercise: Exercise, submission: Path | None, *, hidden: bool,
     isolation = detect()
     if isolation.mode == "user":  # no mount namespace hides them: permissions must
         close_to_others(protected_paths(exercise.folder.parent.parent))
-    record, warnings = _record_folder(record)
+    record, warnings = record_folder(record)
     plan = _Plan.of(exercise, hidden)
     wanted = 1 if domain is not None else children_for(module_jobs, len(plan.modules),
                                                           machine_cores())
@@ -181,7 +181,7 @@ class _Plan:
         return [Path(os.path.relpath(m, root)).as_posix() for m in self.modules]
 
 
-def _record_folder(record: Path | None) -> tuple[Path | None, list[str]]:
+def record_folder(record: Path | None) -> tuple[Path | None, list[str]]:
     """The recordings' folder, made and absolute; None and a warning if it cannot be made
     (the grading goes on without recording)."""
     if record is None:
@@ -247,7 +247,7 @@ def _run(exercise: Exercise, submission: Path | None, plan: _Plan,
         ended = [children.end(child) for child in running]
     elapsed = time.monotonic() - started
     raw = merge(([e.raw for e in ended]), plan.order(exercise.folder))
-    result = _result(exercise, raw, ended, elapsed, all_tests=plan.all_tests)
+    result = verdict(exercise, raw, ended, elapsed, all_tests=plan.all_tests)
     timing = _timing(raw.data, min(e.launched for e in ended), elapsed)
     memory = _memory(raw.data.get("memory"), footprint.peak_mb)
     return dataclasses.replace(result, timing={**timing, "children": len(ended)},
@@ -355,7 +355,7 @@ def _forged(exercise: Exercise, elapsed: float) -> RunResult:
                      execution_time=elapsed, forged=True)
 
 
-def _result(exercise: Exercise, raw_report: RawReport, ended: Sequence[children.Ended],
+def verdict(exercise: Exercise, raw_report: RawReport, ended: Sequence[children.Ended],
             elapsed: float, all_tests: bool = True) -> RunResult:
     """The verdict on the merged report: each child's tests as that child ended (those of
     a child stopped at the time limit say so; a child that broke is the grader's fault)."""

@@ -161,13 +161,16 @@ def test_a_real_tree_is_found_and_summed() -> None:
 def test_another_users_process_counts_its_resident_size() -> None:
     """Sampled by a user who may not read its rollup (``nobody``), this process counts its
     resident size from statm, which anyone may read: more than its PSS, never nothing."""
-    code = ("import sys\n"
-            "from autograder.grading.footprint import _page_kb, _read, process_kb, "
-            "resident_kb\n"
+    code = ("import os, sys\n"
+            "from autograder.grading.footprint import process_kb, resident_kb\n"
             "pid = int(sys.argv[1])\n"
-            "rollup = _read(f'/proc/{pid}/smaps_rollup')\n"
-            "print(rollup is None, process_kb(pid),"
-            " resident_kb(_read(f'/proc/{pid}/statm'), _page_kb()))\n")
+            "try:\n"
+            "    unreadable = not open(f'/proc/{pid}/smaps_rollup').read()\n"
+            "except OSError:\n"
+            "    unreadable = True\n"
+            "with open(f'/proc/{pid}/statm') as statm:\n"
+            "    resident = resident_kb(statm.read(), os.sysconf('SC_PAGE_SIZE') // 1024)\n"
+            "print(unreadable, process_kb(pid), resident)\n")
     root = Path(__file__).resolve().parents[2]
     out = subprocess.run([sys.executable, "-c", code, str(os.getpid())], cwd=root,
                          env={**os.environ, "PYTHONPATH": str(root)}, user=65534,

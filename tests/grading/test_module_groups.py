@@ -15,7 +15,7 @@ from autograder.core.report import RawReport, RawTest
 from autograder.core.results import RunResult
 from autograder.grading.children import Child, Ended
 from autograder.grading.module_groups import children_for, find_modules, merge, share_out
-from autograder.grading.run import GRADER_FAULT, _result
+from autograder.grading.run import GRADER_FAULT, verdict
 
 PUBLIC, HIDDEN_A, HIDDEN_B = "tests/public/test_p.py", "tests/hidden/test_a.py", \
     "tests/hidden/test_b.py"
@@ -191,7 +191,7 @@ def _ended(*tests: RawTest, returncode: int | None = 1, timed_out: bool = False,
 
 def _outcome(*ended: Ended) -> RunResult:
     raw = merge([e.raw for e in ended], ORDER)
-    return _result(load_exercise(SHOUT), raw, ended, 1.0)
+    return verdict(load_exercise(SHOUT), raw, ended, 1.0)
 
 
 def test_a_child_stopped_at_the_time_limit_says_so_for_its_own_tests_only() -> None:
