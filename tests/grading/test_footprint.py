@@ -21,7 +21,6 @@ from autograder.grading.footprint import (
     resident_kb,
     tree_kb,
 )
-from autograder.grading.run import _memory
 
 ROLLUP = """\
 55d1c1e4f000-7ffd6a1b6000 ---p 00000000 00:00 0                          [rollup]
@@ -117,14 +116,6 @@ def test_the_footprint_keeps_the_peak_sampling_at_most_every_interval(proc: Path
     footprint.sample(now=101.0)  # lower now: the peak stays
     assert (footprint.samples, footprint.peak_kb) == (3, first + 100_000)
     assert footprint.peak_mb == round((first + 100_000) / 1024, 1)
-
-
-def test_the_results_memory_adds_the_footprint_beside_the_childrens_peaks() -> None:
-    peaks = {"grader_mb": 185.6, "student_mb": 184.0, "total_mb": 369.6}
-    assert _memory(peaks, 209.8) == {**peaks, "footprint_mb": 209.8}
-    assert _memory(peaks, None) == peaks  # no sample taken
-    assert _memory(None, 50.0) == {"footprint_mb": 50.0}
-    assert _memory(None, None) == {}
 
 
 def test_a_real_tree_is_found_and_summed() -> None:

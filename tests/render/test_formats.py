@@ -10,7 +10,15 @@ from fractions import Fraction
 
 import pytest
 
-from autograder.core.results import NotRun, RunResult, TestResult
+from autograder.core.results import (
+    Containment,
+    MemoryUse,
+    NotRun,
+    ProcessBounds,
+    RunResult,
+    RunTiming,
+    TestResult,
+)
 from autograder.i18n import set_language
 from autograder.render.gradescope import to_gradescope, to_gradescope_dict
 from autograder.render.html import to_html
@@ -206,15 +214,20 @@ def test_urdu_html_report_is_right_to_left():
 
 def test_the_results_file_reads_back_with_its_timing_memory_and_pacing():
     """A batch resuming from its reports, and the proofs' diagnoses, read these back."""
-    data = {"isolation": {"mode": "strict"}, "timing": {"total": 9.1, "modules": {}},
-            "memory": {"grader_mb": 90.0, "student_mb": 80.0, "total_mb": 170.0,
-                       "footprint_mb": 120.5},
+    data = {"isolation": Containment("strict", True, True, False, True,
+                                     bounds=ProcessBounds("v2", "cgroup", "cgroup", None),
+                                     student_uids=(61003,)),
+            "timing": RunTiming(child_start=None, total=9.1, tests=8.0,
+                                modules={"test_a.py": {"total": 8.0}}, children=1),
+            "memory": MemoryUse(grader_mb=90.0, student_mb=80.0, total_mb=170.0,
+                                footprint_mb=120.5),
             "pacing": {"test_a.py": {"idle": 10, "late_deliveries": 1}},
-            "warnings": ["w"], "bags": {"test_a.py": "a.mcap"}}
-    written = json.loads(to_json(dataclasses.replace(
-        result(), **{**data, "warnings": tuple(data["warnings"])})))
+            "warnings": ("w",), "bags": {"test_a.py": "a.mcap"}}
+    written = json.loads(to_json(dataclasses.replace(result(), **data)))
+    assert written["isolation"]["student_uids"] == [61003]
+    assert written["memory"]["footprint_mb"] == 120.5 and written["timing"]["children"] == 1
     again = RunResult.from_dict(written)
-    assert {key: getattr(again, key) for key in data} == {**data, "warnings": ("w",)}
+    assert {key: getattr(again, key) for key in data} == data
     assert json.loads(to_json(again)) == written
 
 

@@ -13,7 +13,7 @@ from click.testing import CliRunner
 
 import sim.cli
 from autograder.cli import main
-from autograder.core.results import RunResult, TestResult
+from autograder.core.results import Containment, RunResult, TestResult
 from autograder.i18n import set_language
 from autograder.render.html import to_html
 from autograder.render.terminal import to_terminal
@@ -36,9 +36,10 @@ def _result(**fields: Any) -> RunResult:
                      tests=(test,), **fields)
 
 
-def _isolation(mode: str) -> dict[str, Any]:
+def _isolation(mode: str) -> Containment:
     reason = "" if mode == "strict" else "the grader does not run as root"
-    return {**Isolation(mode, reason).to_dict(), "bounds": BOUNDS}  # type: ignore[arg-type]
+    return Containment.from_dict(
+        {**Isolation(mode, reason).to_dict(), "bounds": BOUNDS})  # type: ignore[arg-type]
 
 
 @pytest.mark.parametrize(("mode", "sentence"), [

@@ -16,6 +16,7 @@ from pathlib import Path
 import pytest
 
 from autograder.core.report import RawReport
+from autograder.core.results import Containment
 from autograder.grading import children
 from autograder.grading.children import Child, Watchers
 from autograder.render.terminal import isolation_line
@@ -36,12 +37,16 @@ def test_only_a_user_of_its_own_gives_official_grades():
     assert Isolation("user").to_dict()["network"] is True  # said, not hidden
 
 
+def _contained(isolation: Isolation) -> Containment:
+    """What the results say of a grading in this shape, bounded by rlimits alone."""
+    return Containment.from_dict({**isolation.to_dict(), "bounds": BOUNDS})
+
+
 def test_the_terminal_says_which_shape_and_whether_the_grade_is_official():
-    strict = isolation_line({**Isolation("strict").to_dict(), "bounds": BOUNDS})
-    user = isolation_line({**Isolation("user", "namespaces are not allowed here (an "
-                                       "unprivileged container?)").to_dict(), "bounds": BOUNDS})
-    basic = isolation_line({**Isolation("basic", "the grader does not run as root").to_dict(),
-                            "bounds": BOUNDS})
+    strict = isolation_line(_contained(Isolation("strict")))
+    user = isolation_line(_contained(Isolation(
+        "user", "namespaces are not allowed here (an unprivileged container?)")))
+    basic = isolation_line(_contained(Isolation("basic", "the grader does not run as root")))
     assert strict.startswith("Isolation: strict") and "official" not in strict
     assert user.startswith("Isolation: by user, namespaces are not allowed here")
     assert "the network and the machine's processes in its reach" in user
