@@ -9,15 +9,13 @@ from pathlib import Path
 import pytest
 from babel.messages.pofile import read_po
 from click.testing import CliRunner
+from quiz_course import QUIZ_COURSE
 
 from autograder.cli.i18n import i18n_cli
 from autograder.i18n import translations
 from autograder.quiz.extract import extract_exercise, extract_quiz
 
 REPO = Path(__file__).resolve().parents[2]
-# The quizzes these tests read: a frozen copy, so that editing quizzes/ never breaks a
-# platform test (tests/fixtures/quiz_course/README.md).
-QUIZ_COURSE = Path(__file__).parents[1] / "fixtures" / "quiz_course"
 ALL_TITLE = "Part 2 quiz: Python and ROS 2 with rclpy"
 
 
