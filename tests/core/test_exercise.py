@@ -19,7 +19,6 @@ from autograder.core.exercise import (
     load_exercise,
 )
 from autograder.core.exercise import test_names as names_of_tests  # not a test itself
-from autograder.i18n import set_language
 
 MINIMAL = """\
 id: shout
@@ -27,11 +26,6 @@ title: Shout
 file: shout.py
 node: shouter
 """
-
-
-@pytest.fixture(autouse=True)
-def english() -> None:
-    set_language("en")
 
 
 @pytest.fixture

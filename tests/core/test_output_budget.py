@@ -25,18 +25,12 @@ from autograder.core.output_budget import (
 from autograder.core.report import output_log
 from autograder.core.results import RunResult, TestResult
 from autograder.core.signing import verify
-from autograder.i18n import set_language
 from autograder.plugin.reporter import GradingReporter
 from autograder.plugin.student import StudentNode
 from autograder.render.html import to_html
 from autograder.sandbox.process import BoundedOutput
 
 KEY = b"k" * 32
-
-
-@pytest.fixture(autouse=True)
-def english():
-    set_language("en")
 
 
 def utf8(text: str) -> int:

@@ -12,8 +12,6 @@ from decimal import Decimal
 from fractions import Fraction
 from pathlib import Path
 
-import pytest
-
 from autograder.core.results import (
     Containment,
     MemoryUse,
@@ -26,16 +24,10 @@ from autograder.core.results import (
     exact,
     number,
 )
-from autograder.i18n import set_language
 from autograder.render.jsonfile import to_json
 from autograder.sandbox.isolation import Isolation
 
 FIXTURES = Path(__file__).resolve().parents[1] / "fixtures" / "results"
-
-
-@pytest.fixture(autouse=True)
-def english() -> None:
-    set_language("en")
 
 
 def passed(name: str, points: int = 1, core: bool = False) -> TestResult:

@@ -39,8 +39,6 @@ WITHOUT_OWN_TESTS: frozenset[str] = frozenset({
     "autograder/quiz/localize.py",
     "autograder/quiz/views.py",
     "autograder/render/charts.py",
-    "autograder/render/gradescope.py",
-    "autograder/render/junit.py",
     "autograder/render/verdict.py",
     "autograder/sandbox/contained/launcher.py",
     "autograder/sandbox/contained/runner.py",

@@ -4,7 +4,6 @@ warning when `sim drive` bypasses the student's node."""
 
 from __future__ import annotations
 
-from collections.abc import Iterator
 from fractions import Fraction
 from typing import Any
 
@@ -14,19 +13,11 @@ from click.testing import CliRunner
 import sim.cli
 from autograder.cli import main
 from autograder.core.results import Containment, RunResult, TestResult
-from autograder.i18n import set_language
 from autograder.render.html import to_html
 from autograder.render.terminal import to_terminal
 from autograder.sandbox.isolation import Isolation
 
 BOUNDS = {"cgroup": None, "processes": None, "memory": None}
-
-
-@pytest.fixture(autouse=True)
-def _english() -> Iterator[None]:
-    set_language("en")
-    yield
-    set_language("en")
 
 
 def _result(**fields: Any) -> RunResult:
