@@ -27,7 +27,6 @@ WITHOUT_OWN_TESTS: frozenset[str] = frozenset({
     "autograder/core/errors.py",
     "autograder/core/files.py",
     "autograder/core/report.py",
-    "autograder/core/submission.py",
     "autograder/i18n/label_extract.py",
     "autograder/i18n/templates.py",
     "autograder/plugin/credit.py",
