@@ -25,7 +25,6 @@ WITHOUT_OWN_TESTS: frozenset[str] = frozenset({
     "autograder/commands/written.py",
     "autograder/core/dumpable.py",
     "autograder/core/errors.py",
-    "autograder/core/report.py",
     "autograder/i18n/label_extract.py",
     "autograder/i18n/templates.py",
     "autograder/plugin/credit.py",
