@@ -4,6 +4,7 @@ and what the grader reads back; the programs' output beside it, read only as vou
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
 from autograder.core.report import RawReport, RawTest, keep_log, output_log, read, write
@@ -76,3 +77,20 @@ def test_a_log_named_outside_its_folder_is_never_read(tmp_path: Path) -> None:
     (tmp_path / "secret.log").write_text("kept\n")
     data["log_files"][0]["file"] = "../secret.log"  # only its name counts: 001's folder
     assert "kept" not in output_log(data, path)
+
+
+def test_a_log_swapped_for_a_link_or_a_fifo_is_left_out_without_waiting(
+        tmp_path: Path) -> None:
+    """A link to a file with the very bytes vouched for is not followed, and a FIFO in a
+    log's place is not opened for a read that would wait for a writer forever."""
+    path, data = logged(tmp_path, "same\n", "piped\n")
+    logs = tmp_path / "report.logs"
+    elsewhere = tmp_path / "elsewhere.log"
+    elsewhere.write_text("same\n")
+    (logs / "001.log").unlink()
+    (logs / "001.log").symlink_to(elsewhere)
+    (logs / "002.log").unlink()
+    os.mkfifo(logs / "002.log")
+    text = output_log(data, path)
+    assert "same" not in text and "piped" not in text
+    assert text.count("changed after your program ran") == 2
