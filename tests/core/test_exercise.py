@@ -67,11 +67,11 @@ limits: {memory_mb: 1024, output_kb: 64}
     assert exercise.limits == Limits(memory_mb=1024, output_kb=64)
 
 
-# The Exercise's own checks (its __post_init__) are reported at the file's first line, the
-# others at the field's.
+# Every mistake is reported at its field's line, the Exercise's own checks (its
+# __post_init__) too.
 @pytest.mark.parametrize(("extra", "where", "message"), [
-    ("pass_mark: 1.5\n", ":1:", "pass_mark must be above 0 and at most 1"),
-    ("core: [a, a]\n", ":1:", "core names a test more than once"),
+    ("pass_mark: 1.5\n", ":6: pass_mark", "pass_mark must be above 0 and at most 1"),
+    ("core: [a, a]\n", ":6: core", "core names a test more than once"),
     ("folder: /etc\n", ":6: folder", "set by the loader, not in the file"),
     ("limits: {memory_mb: lots}\n", ":6: limits.memory_mb", ""),
     ("hidden_visibility: secret\n", ":6: hidden_visibility", "must be one of"),
