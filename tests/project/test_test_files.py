@@ -36,8 +36,6 @@ WITHOUT_OWN_TESTS: frozenset[str] = frozenset({
     "autograder/quiz/localize.py",
     "autograder/quiz/views.py",
     "autograder/render/charts.py",
-    "autograder/sandbox/startup_check.py",
-    "autograder/sandbox/sweep.py",
     "sim/faultkinds.py",
     "sim/msgdefs.py",
     "sim/svg.py",

@@ -1,13 +1,12 @@
 """Nothing of the student's is run or imported by a privileged process of the grader
-(issue 28): modules named like the standard library's beside the node, and what a program
-leaves behind for its user. Links, devices and FIFOs in a submission, never followed or
-read: tests/core/test_submission.py."""
+(issue 28): modules named like the standard library's beside the node. What a program
+leaves behind for its user, swept: tests/sandbox/test_sweep.py. Links, devices and FIFOs
+in a submission, never followed or read: tests/core/test_submission.py."""
 
 from __future__ import annotations
 
 import ctypes
 import os
-import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -15,10 +14,9 @@ from pathlib import Path
 import pytest
 
 from autograder.core.exercise import Limits
-from autograder.sandbox.isolation import detect, student_uid
+from autograder.sandbox.isolation import detect
 from autograder.sandbox.privileged import SAFE_CWD, module_command
 from autograder.sandbox.process import student_process
-from autograder.sandbox.sweep import is_student_uid, kill_user, sweep_user, user_ipc
 
 REPO = Path(__file__).resolve().parents[2]
 COURSE = REPO / "tests" / "fixtures" / "mini_course"
@@ -27,8 +25,6 @@ SHADOWS = ("json", "ctypes", "resource", "sitecustomize", "usercustomize", "runp
 
 strict_only = pytest.mark.skipif(not detect().strict,
                                  reason=f"needs strict isolation: {detect().reason}")
-root_only = pytest.mark.skipif(os.geteuid() != 0 or shutil.which("setpriv") is None,
-                               reason="needs root and setpriv to act as a student's user")
 
 
 # -- a privileged Python never imports the student's modules --------------------------
@@ -78,40 +74,6 @@ def test_an_isolated_command_ignores_the_folder_it_starts_in(tmp_path):
     plain = subprocess.run([sys.executable, "-c", "import json, runpy"], capture_output=True,
                            text=True, timeout=60, cwd=tmp_path)
     assert "SHADOW json IMPORTED" in plain.stdout  # the test can fail
-
-
-# -- a student's user leaves nothing behind --------------------------------------------
-def test_only_students_own_users_are_swept():
-    assert is_student_uid(student_uid(10)) and is_student_uid(student_uid(101))
-    for uid in (0, os.getuid(), 1000, 65534, student_uid(0) - 1):
-        assert not is_student_uid(uid)
-        with pytest.raises(ValueError):
-            kill_user(uid)
-
-
-@root_only
-def test_the_sweep_ends_a_users_processes_its_ipc_and_its_scratch_files(tmp_path):
-    """A daemon in a session of its own, a SysV segment and a file in /dev/shm, all of a
-    student's user and outside any process group or cgroup the grader knows: swept."""
-    uid = student_uid(230)  # a domain no grading reserves
-    code = ("import ctypes, os, time\n"
-            "libc = ctypes.CDLL(None)\n"
-            "print(libc.shmget(0x5A1A0000 + os.getpid() % 0x10000, 4096, 0o1666), flush=True)\n"
-            f"open('/dev/shm/autograder-sweep-test-{uid}', 'w').write('x')\n"
-            "if os.fork() == 0:\n"
-            "    os.setsid()\n"
-            "    time.sleep(600)\n"
-            "os._exit(0)\n")
-    subprocess.run(["setpriv", f"--reuid={uid}", f"--regid={uid}", "--clear-groups",
-                    sys.executable, "-I", "-c", code], check=True, cwd="/", timeout=60)
-    from autograder.sandbox.sweep import user_processes
-
-    assert user_processes(uid), "the daemon runs"
-    assert user_ipc(uid), "the segment exists"
-    assert sweep_user(uid)
-    assert user_processes(uid) == []
-    assert user_ipc(uid) == []
-    assert not Path(f"/dev/shm/autograder-sweep-test-{uid}").exists()
 
 
 @strict_only
