@@ -23,8 +23,6 @@ WITHOUT_OWN_TESTS: frozenset[str] = frozenset({
     "autograder/commands/hand_run.py",
     "autograder/commands/start.py",
     "autograder/commands/written.py",
-    "autograder/core/dumpable.py",
-    "autograder/core/errors.py",
     "autograder/i18n/label_extract.py",
     "autograder/i18n/templates.py",
     "autograder/plugin/credit.py",
