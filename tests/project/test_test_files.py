@@ -23,14 +23,11 @@ WITHOUT_OWN_TESTS: frozenset[str] = frozenset({
     "autograder/commands/hand_run.py",
     "autograder/commands/start.py",
     "autograder/commands/written.py",
-    "autograder/i18n/label_extract.py",
-    "autograder/i18n/templates.py",
     "autograder/plugin/graph.py",
     "autograder/plugin/world.py",
     "sim/faultkinds.py",
     "sim/msgdefs.py",
     "sim/svg.py",
-    "content/i18n.py",
 })
 
 
