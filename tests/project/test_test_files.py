@@ -25,9 +25,6 @@ WITHOUT_OWN_TESTS: frozenset[str] = frozenset({
     "autograder/commands/written.py",
     "autograder/plugin/graph.py",
     "autograder/plugin/world.py",
-    "sim/faultkinds.py",
-    "sim/msgdefs.py",
-    "sim/svg.py",
 })
 
 
