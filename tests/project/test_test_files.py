@@ -18,8 +18,6 @@ ROOTS = ("autograder", "sim", "content")
 SKIPPED = ("__init__.py", "__main__.py")
 
 WITHOUT_OWN_TESTS: frozenset[str] = frozenset({
-    "autograder/cli/click_words.py",
-    "autograder/cli/i18n.py",
     "autograder/commands/hand_run.py",
     "autograder/commands/start.py",
     "autograder/commands/written.py",
