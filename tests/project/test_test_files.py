@@ -19,8 +19,6 @@ SKIPPED = ("__init__.py", "__main__.py")
 
 WITHOUT_OWN_TESTS: frozenset[str] = frozenset({
     "autograder/commands/hand_run.py",
-    "autograder/commands/start.py",
-    "autograder/commands/written.py",
     "autograder/plugin/graph.py",
     "autograder/plugin/world.py",
 })
