@@ -23,9 +23,12 @@ HEADER = 'msgid ""\nmsgstr "Content-Type: text/plain; charset=UTF-8\\n"\n\n'
 
 @pytest.fixture(autouse=True)
 def language() -> Iterator[None]:
-    before = content.i18n.get_language(), content.i18n._find_locales
+    """Afterwards, the language and the catalogs' folder the autograder set (as it sets
+    them whenever its language changes)."""
     yield
-    content.i18n._language, content.i18n._find_locales = before
+    from autograder.i18n import get_language, set_language
+
+    set_language(get_language())
 
 
 def _po(folder: Path, entries: str) -> Path:

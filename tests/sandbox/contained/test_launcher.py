@@ -220,15 +220,15 @@ def test_user_tasks_counts_threads_as_rlimit_nproc_does(tmp_path):
 def test_the_barrier_above_a_needed_path(monkeypatch):
     """The topmost folder the student would not get through: a fresh one (/tmp), else one
     closed to other users; none for a path open all the way."""
-    assert launcher._barrier("/tmp/venv/bin/python3") == "/tmp"
-    assert launcher._barrier("/usr/lib") is None
+    assert launcher.barrier_above("/tmp/venv/bin/python3") == "/tmp"
+    assert launcher.barrier_above("/usr/lib") is None
     monkeypatch.setattr(launcher, "FRESH", ())
     closed = tempfile.mkdtemp(dir="/tmp")  # 0700
     try:
         os.makedirs(os.path.join(closed, "venv", "lib"))
-        assert launcher._barrier(os.path.join(closed, "venv", "lib")) == closed
+        assert launcher.barrier_above(os.path.join(closed, "venv", "lib")) == closed
         os.chmod(closed, 0o755)
-        assert launcher._barrier(os.path.join(closed, "venv", "lib")) is None
+        assert launcher.barrier_above(os.path.join(closed, "venv", "lib")) is None
     finally:
         subprocess.run(["rm", "-rf", closed], check=False)
 
