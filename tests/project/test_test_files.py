@@ -18,7 +18,6 @@ ROOTS = ("autograder", "sim", "content")
 SKIPPED = ("__init__.py", "__main__.py")
 
 WITHOUT_OWN_TESTS: frozenset[str] = frozenset({
-    "autograder/plugin/graph.py",
     "autograder/plugin/world.py",
 })
 
