@@ -31,10 +31,6 @@ ALLOWED: frozenset[tuple[str, str]] = frozenset({
     # plugin/student: the node's endpoints and the wait for it on the graph (fixture-only).
     ("tests/plugin/test_student.py", "autograder.plugin.student._node_endpoints"),
     ("tests/plugin/test_student.py", "autograder.plugin.student._wait_for_node"),
-    # sim/cli: the warning on a mismatched cmd_vel type, printed by `sim run` as it runs.
-    ("tests/sim/test_cmdvel.py", "sim.cli._warn_mismatches"),
-    # sim/raycast: the bound on its cache of prepared obstacles.
-    ("tests/sim/test_raycast.py", "sim.raycast._cache"),
 })
 
 
