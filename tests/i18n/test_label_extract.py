@@ -64,6 +64,11 @@ def test_a_file_that_does_not_parse_gives_its_calls_only():
     assert [message for _line, _func, message, _c in found] == ["still found"]
 
 
+def test_a_file_with_an_unclosed_bracket_gives_the_calls_before_it():
+    found = _extract(b'x = _("still found")\ny = f(\ndef test_broken():\n    """Lost"""\n')
+    assert [message for _line, _func, message, _c in found] == ["still found"]
+
+
 def test_babel_runs_it_by_module_path_with_the_label_comment():
     messages = list(extract("autograder.i18n.label_extract:extract_tests",
                             io.BytesIO(SOURCE)))
