@@ -11,12 +11,19 @@ TESTS = '''
     import pytest
     from fractions import Fraction
 
+    pytestmark = [pytest.mark.world("corridor"), pytest.mark.parameters({"speed": 0.5})]
+
     @pytest.mark.points(3)
     @pytest.mark.visibility("after_published")
     @pytest.mark.reveal("status")
-    @pytest.mark.world("corridor")
-    @pytest.mark.parameters({"speed": 0.5})
     def test_all_well_formed(): pass
+
+    @pytest.mark.world("obstacle_course")
+    def test_world_of_its_own(): pass
+
+    @pytest.mark.parameters({"speed": 0.2})
+    class TestParametersOfItsOwn:
+        def test_in_it(self): pass
 
     @pytest.mark.points(0.5)
     def test_half_a_point(): pass
@@ -91,6 +98,19 @@ def test_a_malformed_marker_is_named_with_what_it_should_be(problems, name, mark
     assert problem is not None, name
     assert f"::{name}: marker " in problem  # the test's node id first
     assert problem.endswith(f"marker {MARKERS[marker]}; got {got}")
+
+
+@pytest.mark.parametrize(("name", "marker", "on"), [
+    ("test_world_of_its_own", "world", "test_world_of_its_own"),
+    ("test_in_it", "parameters", "TestParametersOfItsOwn"),
+])
+def test_a_module_marker_on_a_test_or_class_is_named_not_ignored(problems, name, marker, on):
+    """The world and the student's parameters are the module's, started once for all its
+    tests: on one test or class they would be silently unused."""
+    assert problems[name] == (f"test_a_module_marker_on_a_test_or_class_is_named_not_ignored"
+                              f".py::{'TestParametersOfItsOwn::' if on != name else ''}{name}"
+                              f": marker {MARKERS[marker]}; found on {on!r}, where it would "
+                              "not be used")
 
 
 def test_every_marker_says_its_form():
