@@ -31,9 +31,9 @@ import functools
 import statistics
 import time
 from collections.abc import Sequence
-from typing import Any
 
 from autograder.core.exercise import find_exercise, list_exercises
+from autograder.core.results import MemoryUse, RunTiming
 from autograder.grading.capacity import machine_cores, measured
 from autograder.grading.footprint import INTERVAL
 from autograder.grading.run import grade
@@ -49,8 +49,8 @@ def main() -> None:
     exercises = [find_exercise(e) for e in args.exercises] or list_exercises()
     print(f"{'exercise':<22} {'score':>7} {'wall median':>12} {'min':>7} {'max':>7} "
           f"{'cpu median':>11} {'node seen after (median)':>25}  ticks idle/cpu share/cap")
-    timings: dict[str, list[dict[str, Any]]] = {}
-    memory: dict[str, list[dict[str, float]]] = {}
+    timings: dict[str, list[RunTiming]] = {}
+    memory: dict[str, list[MemoryUse]] = {}
     cpu_medians: dict[str, float] = {}
     floors: dict[str, tuple[float, float, float, float]] = {}
     for exercise in exercises:
@@ -64,8 +64,9 @@ def main() -> None:
             cpus.append(share * walls[-1])
             startups += list(result.startup_seconds)
             scores.add(f"{result.score}/{result.max_score}")
-            timings.setdefault(exercise.id, []).append(result.timing)
-            if result.memory:
+            if result.timing is not None:
+                timings.setdefault(exercise.id, []).append(result.timing)
+            if result.memory is not None:
                 memory.setdefault(exercise.id, []).append(result.memory)
             for module in result.pacing.values():
                 ticks.update({k: v for k, v in module.items() if k in ("idle", "budget", "cap")})
@@ -104,22 +105,22 @@ def main() -> None:
           f"whole process tree (this process included) summed, sampled every {INTERVAL:g} s")
     print(f"{'exercise':<22} {'grader':>8} {'student':>8} {'total':>8} {'footprint':>10}")
     for name, runs in memory.items():
-        peak = max(runs, key=lambda m: m.get("total_mb", 0.0))
-        footprints = [m["footprint_mb"] for m in runs if m.get("footprint_mb") is not None]
+        peak = max(runs, key=lambda m: m.total_mb or 0.0)
+        footprints = [m.footprint_mb for m in runs if m.footprint_mb is not None]
         footprint = f"{max(footprints):>10.1f}" if footprints else f"{'-':>10}"
-        print(f"{name:<22} {peak.get('grader_mb', 0.0):>8.1f} "
-              f"{peak.get('student_mb', 0.0):>8.1f} {peak.get('total_mb', 0.0):>8.1f} "
+        print(f"{name:<22} {peak.grader_mb or 0.0:>8.1f} "
+              f"{peak.student_mb or 0.0:>8.1f} {peak.total_mb or 0.0:>8.1f} "
               f"{footprint}")
 
 
-def _floor(timings: Sequence[dict[str, Any]], rtf: float,
+def _floor(timings: Sequence[RunTiming], rtf: float,
            wall: float) -> tuple[float, float, float, float]:
     """(sim seconds summed, floor, longest module's floor, wall over floor), medians over
     the runs' ``timing``; floors are 0 for an exercise without a pace (``rtf`` 0)."""
     sums, longest = [], []
     for timing in timings:
         by_module: collections.Counter[str] = collections.Counter()
-        for nodeid, seconds in (timing.get("sim_seconds") or {}).items():
+        for nodeid, seconds in timing.sim_seconds.items():
             by_module[nodeid.partition("::")[0]] += seconds
         sums.append(sum(by_module.values()))
         longest.append(max(by_module.values(), default=0.0))
@@ -128,14 +129,14 @@ def _floor(timings: Sequence[dict[str, Any]], rtf: float,
     return sim, floor, most / rtf if rtf > 0 else 0.0, wall / floor if floor else 0.0
 
 
-def _phases(timing: dict[str, Any], phases: Sequence[str]) -> dict[str, float]:
+def _phases(timing: RunTiming, phases: Sequence[str]) -> dict[str, float]:
     """One grading's seconds per column: ``child_start``, each of ``phases``, ``checks``,
     ``rest`` and ``total``."""
-    modules = timing.get("modules", {}).values()
+    modules = timing.modules.values()
     row = {p: sum(m[p] for m in modules) for p in (*phases, "checks")}
-    row["child_start"] = timing.get("child_start") or 0.0
-    row["total"] = timing.get("total", 0.0)
-    row["rest"] = max(0.0, row["total"] - row["child_start"] - timing.get("tests", 0.0))
+    row["child_start"] = timing.child_start or 0.0
+    row["total"] = timing.total
+    row["rest"] = max(0.0, row["total"] - row["child_start"] - timing.tests)
     return row
 
 

@@ -6,6 +6,13 @@ gettext binding the simulator and these files speak through (:mod:`content.i18n`
 Nothing here imports ``sim`` or ``autograder``: both import this.
 """
 
-from content.document import ContentError, Document, build, describe, load_document
+from content.document import (
+    ContentError,
+    Document,
+    FieldValueError,
+    build,
+    describe,
+    load_document,
+)
 
-__all__ = ["ContentError", "Document", "build", "describe", "load_document"]
+__all__ = ["ContentError", "Document", "FieldValueError", "build", "describe", "load_document"]

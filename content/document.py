@@ -42,6 +42,15 @@ class ContentError(Exception):
         return f"{where}: {self.message}"
 
 
+class FieldValueError(ValueError):
+    """A dataclass's own check (its ``__post_init__``) that one field broke: :func:`build`
+    names that field's line, as it does for a wrong type."""
+
+    def __init__(self, message: str, field: str) -> None:
+        super().__init__(message)
+        self.field = field
+
+
 @dataclasses.dataclass(frozen=True)
 class Document:
     """A parsed YAML file: plain Python data plus the line of every key and item."""
@@ -207,7 +216,9 @@ def build(cls: type[T], doc: Document, data: Any, where: tuple[str | int, ...] =
         kwargs[name] = _check_type(doc, data[name], hints[name], (*where, name))
     try:
         return cls(**kwargs)
-    except ValueError as exc:  # a __post_init__ check
+    except FieldValueError as exc:  # a __post_init__ check of one field
+        raise doc.error(str(exc), *where, exc.field) from None
+    except ValueError as exc:  # a __post_init__ check of the whole
         raise doc.error(str(exc), *where) from None
 
 

@@ -177,7 +177,7 @@ def run_world(spec: WorldSpec, *, rtf: float, duration: float | None, domain: in
             if recorder is not None:
                 _record_drivers(bridge)
             bridge.wait_for(over, sim_timeout=math.inf, wall_timeout=0.5)
-            _warn_mismatches(bridge, warned)
+            warn_mismatches(bridge, warned)
     except KeyboardInterrupt:
         pass
     finally:
@@ -344,7 +344,7 @@ def _record_drivers(bridge: SimBridge) -> None:
             bridge.listen(topic, found)
 
 
-def _warn_mismatches(bridge: SimBridge, warned: set[object]) -> None:
+def warn_mismatches(bridge: SimBridge, warned: set[object]) -> None:
     """Say once of each publisher on /cmd_vel whose type the robot does not take."""
     from sim.cmdvel import world_warning
 

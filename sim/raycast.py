@@ -134,6 +134,12 @@ def prepare(segments: np.ndarray, circles: np.ndarray) -> Targets:
 
 
 _cache: dict[tuple[int, int], tuple[weakref.ref, weakref.ref, Targets]] = {}
+CACHED_AT_MOST = 32
+
+
+def cached() -> int:
+    """How many prepared geometries :func:`prepared` keeps now (at most CACHED_AT_MOST)."""
+    return len(_cache)
 
 
 def prepared(segments: np.ndarray, circles: np.ndarray) -> Targets:
@@ -144,11 +150,12 @@ def prepared(segments: np.ndarray, circles: np.ndarray) -> Targets:
     hit = _cache.get(key)
     if hit is not None and hit[0]() is segments and hit[1]() is circles:
         return hit[2]
-    if len(_cache) >= 32:  # forget geometry that is gone (the bridge's thread may scan too)
+    if len(_cache) >= CACHED_AT_MOST:  # forget geometry that is gone (the bridge's thread
+        # may scan too)
         for old, (s, c, _t) in list(_cache.items()):
             if s() is None or c() is None:
                 _cache.pop(old, None)
-        if len(_cache) >= 32:
+        if len(_cache) >= CACHED_AT_MOST:
             _cache.clear()
     targets = prepare(segments, circles)
     _cache[key] = (weakref.ref(segments), weakref.ref(circles), targets)

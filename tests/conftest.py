@@ -19,6 +19,20 @@ from autograder.sandbox.domains import reserve_domain
 pytest_plugins = ["pytester"]
 
 
+@pytest.fixture
+def in_quiz_course(monkeypatch: pytest.MonkeyPatch) -> Iterator[Path]:
+    """The frozen quiz course (tests/quiz_course.py) is the course: commands that find
+    quizzes by id find its, and pages are translated with its content catalog."""
+    from quiz_course import QUIZ_COURSE
+
+    from autograder.i18n import translations
+
+    monkeypatch.setenv("AUTOGRADER_COURSE", str(QUIZ_COURSE))
+    translations.cache_clear()
+    yield QUIZ_COURSE
+    translations.cache_clear()
+
+
 @pytest.fixture(scope="module")
 def ros_domain() -> Iterator[int]:
     """A ROS domain id reserved for this module (the same lock files the grader uses)."""

@@ -10,7 +10,7 @@ from typing import Literal
 
 from autograder.core.names import unknown_exercise
 from autograder.i18n import _, content_text
-from content import ContentError, build, load_document
+from content import ContentError, FieldValueError, build, load_document
 from content.course import course_root
 from sim.pacing import DEFAULT_CLOCK_HZ, DEFAULT_CPU_BUDGET
 
@@ -86,9 +86,9 @@ class Exercise:
 
     def __post_init__(self) -> None:
         if not 0 < self.pass_mark <= 1:
-            raise ValueError(_("pass_mark must be above 0 and at most 1"))
+            raise FieldValueError(_("pass_mark must be above 0 and at most 1"), "pass_mark")
         if len(set(self.core)) != len(self.core):
-            raise ValueError(_("core names a test more than once"))
+            raise FieldValueError(_("core names a test more than once"), "core")
 
     @property
     def localized_title(self) -> str:

@@ -1,9 +1,9 @@
 """How much of a student program's output goes where.
 
 The sandbox keeps up to a budget of each program's output (its first and last halves, see
-``autograder.sandbox.process._Output``). Test messages are repeated by every results format, once
-per test, so they carry only :func:`message_tail`: a few short lines of the end. The whole
-kept output goes once into the HTML report and into a log file beside the results.
+``autograder.sandbox.process.BoundedOutput``). Test messages are repeated by every results
+format, once per test, so they carry only :func:`message_tail`: a few short lines of the end.
+The whole kept output goes once into the HTML report and into a log file beside the results.
 
 The pytest child writes each program's kept output to a file of its own beside the raw
 report (:func:`log_folder`) when the program stops, and the signed report names each file

@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import os
+import stat
 from pathlib import Path
 from typing import Any
 
@@ -106,10 +108,16 @@ def output_log(data: dict[str, Any], path: Path) -> str:
 def _read_log(folder: Path, entry: dict[str, Any]) -> str:
     """One program's kept output, if the file is the one the report vouches for."""
     path = folder / Path(entry["file"]).name
-    try:  # the size first: a file swapped for a huge one is not read
-        raw = path.read_bytes() if path.stat().st_size == entry["bytes"] else b""
+    raw = b""
+    try:  # not through a link, never blocking on a FIFO, and the size before the read
+        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
     except OSError:
-        raw = b""
+        fd = None
+    if fd is not None:
+        with os.fdopen(fd, "rb") as fh:
+            found = os.fstat(fh.fileno())
+            if stat.S_ISREG(found.st_mode) and found.st_size == entry["bytes"]:
+                raw = fh.read(entry["bytes"])
     if digest(raw) != entry["sha256"]:
         return _("(This output was changed after your program ran, so it is left out.)")
     return raw.decode("utf-8", "replace")

@@ -126,6 +126,126 @@ class NotRun:
         return _("The grade also runs hidden tests.")
 
 
+@dataclasses.dataclass(frozen=True)
+class ProcessBounds:
+    """Which bounds held the student's programs
+    (:func:`autograder.sandbox.cgroups.describe_bounds`): the cgroup hierarchy they ran in
+    (``"v2"``, ``"v1"``, None) and, for processes, memory and CPU, ``"cgroup"``,
+    ``"rlimit"`` or None (nothing)."""
+
+    cgroup: str | None = None
+    processes: str | None = None
+    memory: str | None = None
+    cpu: str | None = None
+
+    def to_dict(self) -> dict[str, str | None]:
+        return {"cgroup": self.cgroup, "processes": self.processes, "memory": self.memory,
+                "cpu": self.cpu}
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> ProcessBounds:
+        return cls(cgroup=data.get("cgroup"), processes=data.get("processes"),
+                   memory=data.get("memory"), cpu=data.get("cpu"))
+
+
+@dataclasses.dataclass(frozen=True)
+class Containment:
+    """How a grading contained the student's programs: the machine's isolation
+    (:meth:`autograder.sandbox.isolation.Isolation.to_dict`, ``mode`` one of ``"strict"``,
+    ``"user"``, ``"basic"``), the bounds that held the programs (None: no program
+    started) and the users they ran as (None: the grader's own)."""
+
+    mode: str
+    official: bool
+    separate_user: bool
+    network: bool
+    hidden_files_protected: bool
+    reason: str = ""
+    detail: str = ""
+    bounds: ProcessBounds | None = None
+    student_uids: tuple[int, ...] | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"mode": self.mode, "official": self.official,
+                "separate_user": self.separate_user, "network": self.network,
+                "hidden_files_protected": self.hidden_files_protected,
+                "reason": self.reason, "detail": self.detail,
+                "bounds": None if self.bounds is None else self.bounds.to_dict(),
+                "student_uids": None if self.student_uids is None else list(self.student_uids)}
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> Containment:
+        """Read what :meth:`to_dict` wrote, or an ``Isolation.to_dict()`` with ``bounds``
+        and ``student_uids`` beside it."""
+        bounds, uids = data.get("bounds"), data.get("student_uids")
+        return cls(mode=data["mode"], official=bool(data["official"]),
+                   separate_user=bool(data["separate_user"]), network=bool(data["network"]),
+                   hidden_files_protected=bool(data["hidden_files_protected"]),
+                   reason=data.get("reason", ""), detail=data.get("detail", ""),
+                   bounds=None if bounds is None else ProcessBounds.from_dict(bounds),
+                   student_uids=None if uids is None else tuple(uids))
+
+
+@dataclasses.dataclass(frozen=True)
+class RunTiming:
+    """Where a grading's wall seconds went: the children's start (from the first launch to
+    the first test; None if no test started), the tests (summed over the modules, so more
+    than ``total`` when modules run at once), the total from the grader's call, each
+    module's phases (:meth:`autograder.plugin.timing.Timing.to_dict`), each test's
+    simulation seconds to its verdict by node id, and how many child pytests ran."""
+
+    child_start: float | None = None
+    tests: float = 0.0
+    total: float = 0.0
+    modules: Mapping[str, Mapping[str, float]] = dataclasses.field(default_factory=dict)
+    sim_seconds: Mapping[str, float] = dataclasses.field(default_factory=dict)
+    children: int = 0
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"child_start": self.child_start, "tests": self.tests, "total": self.total,
+                "modules": {module: dict(phases) for module, phases in self.modules.items()},
+                "sim_seconds": dict(self.sim_seconds), "children": self.children}
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> RunTiming:
+        return cls(child_start=data.get("child_start"), tests=data.get("tests", 0.0),
+                   total=data.get("total", 0.0), modules=data.get("modules", {}),
+                   sim_seconds=data.get("sim_seconds", {}), children=data.get("children", 0))
+
+
+@dataclasses.dataclass(frozen=True)
+class MemoryUse:
+    """A grading's memory in MB: the children's peak resident sizes, summed (an upper bound,
+    see :func:`autograder.grading.module_groups.merge`: ``grader_mb`` the child pytests,
+    ``student_mb`` the largest student program of each, ``total_mb`` both), and
+    ``footprint_mb``, the peak of the whole grading's summed PSS
+    (:mod:`autograder.grading.footprint`). Each None where it was not measured."""
+
+    grader_mb: float | None = None
+    student_mb: float | None = None
+    total_mb: float | None = None
+    footprint_mb: float | None = None
+
+    def to_dict(self) -> dict[str, float]:
+        """The measured ones only."""
+        return {field.name: value for field in dataclasses.fields(self)
+                if (value := getattr(self, field.name)) is not None}
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> MemoryUse:
+        return cls(**{field.name: data.get(field.name) for field in dataclasses.fields(cls)})
+
+    @classmethod
+    def of(cls, children_peaks: Mapping[str, float] | None,
+           footprint_mb: float | None) -> MemoryUse | None:
+        """The children's merged peaks (the raw report's ``memory``) with the footprint
+        beside them; None if neither was measured."""
+        if not children_peaks and footprint_mb is None:
+            return None
+        return dataclasses.replace(cls.from_dict(children_peaks or {}),
+                                   footprint_mb=footprint_mb)
+
+
 def _show_visible(result: object, *fields: str) -> None:
     """Make a result's ``fields`` (text a program may have written) safe to show anywhere:
     a program's escape sequences and bidi controls as visible escapes
@@ -159,18 +279,19 @@ class RunResult:
     # proves nothing about passing, so it never says passed.
     not_run: NotRun | None = None
     # -- in the JSON results (see to_dict) --
-    # How the student's program was contained: ``Isolation.to_dict()`` with its ``bounds``
-    # and ``student_uids``; None when nothing was started (a fault before the run).
-    isolation: Mapping[str, Any] | None = None
-    # How the world paced itself, per test module (``sim.bridge``).
+    # How the student's program was contained; None when nothing was started (a fault
+    # before the run).
+    isolation: Containment | None = None
+    # How the world paced itself, per test module: the counters ``sim.bridge`` keeps and
+    # ``autograder.plugin.world`` adds to, whose names are theirs (left open here).
     pacing: Mapping[str, Mapping[str, Any]] = dataclasses.field(default_factory=dict)
     # ``--record DIR``: each test module's rosbag2 bag folder.
     bags: Mapping[str, str] = dataclasses.field(default_factory=dict)
     # What the student should know that is no test's verdict (a recording that failed).
     warnings: tuple[str, ...] = ()
-    # Where the wall seconds went (``autograder.plugin.timing``) and the memory.
-    timing: Mapping[str, Any] = dataclasses.field(default_factory=dict)
-    memory: Mapping[str, float] = dataclasses.field(default_factory=dict)
+    # Where the wall seconds went and the memory; None: not measured (no child ran).
+    timing: RunTiming | None = None
+    memory: MemoryUse | None = None
     # The other users whose programs disturbed each grading done again before this one.
     disturbed: tuple[tuple[int, ...], ...] = ()
     # -- for the grader and the reports only --
@@ -240,14 +361,17 @@ class RunResult:
                        hint=t.get("hint", ""), visibility=t.get("visibility", "visible"),
                        reveal=t.get("reveal", "message"), core=t.get("core", False))
             for t in data["tests"])
-        isolation = data.get("isolation")
+        isolation, timing, memory = (data.get(name) for name in ("isolation", "timing",
+                                                                 "memory"))
         return cls(kind=kind, id=data[kind], title=data.get("title", ""), tests=tests,
                    pass_mark=exact(data.get("pass_mark", "0.7")), lang=data.get("lang", "en"),
                    grader_error=data.get("grader_error"),
                    execution_time=data.get("execution_time", 0.0),
-                   isolation=isolation, pacing=data.get("pacing", {}),
+                   isolation=Containment.from_dict(isolation) if isolation else None,
+                   pacing=data.get("pacing", {}),
                    bags=data.get("bags", {}), warnings=tuple(data.get("warnings", ())),
-                   timing=data.get("timing", {}), memory=data.get("memory", {}),
+                   timing=RunTiming.from_dict(timing) if timing else None,
+                   memory=MemoryUse.from_dict(memory) if memory else None,
                    disturbed=tuple(tuple(uids) for uids in data.get("disturbed", ())),
                    not_run=NotRun.from_dict(data["not_run"]) if data.get("not_run") else None)
 
@@ -267,14 +391,14 @@ class RunResult:
             "lang": self.lang,
             "grader_error": self.grader_error,
             "execution_time": round(self.execution_time, 3),
-            **({"isolation": dict(self.isolation)} if self.isolation is not None else {}),
+            **({"isolation": self.isolation.to_dict()} if self.isolation is not None else {}),
             **({"pacing": dict(self.pacing)} if self.pacing else {}),
             **({"bags": dict(self.bags)} if self.bags else {}),
             **({"warnings": list(self.warnings)} if self.warnings else {}),
             **({"disturbed": [list(uids) for uids in self.disturbed]}
                if self.disturbed else {}),
-            **({"timing": dict(self.timing)} if self.timing else {}),
-            **({"memory": dict(self.memory)} if self.memory else {}),
+            **({"timing": self.timing.to_dict()} if self.timing is not None else {}),
+            **({"memory": self.memory.to_dict()} if self.memory is not None else {}),
             "tests": [
                 {
                     "name": t.name,

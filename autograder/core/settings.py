@@ -53,5 +53,8 @@ class RunSettings:
 
     @classmethod
     def from_json(cls, text: str) -> RunSettings:
+        """Read what :meth:`to_json` wrote (JSON's lists back as the fields' tuples); keys
+        of no field are left out."""
         fields = {f.name for f in dataclasses.fields(cls)}
-        return cls(**{k: v for k, v in json.loads(text).items() if k in fields})
+        return cls(**{k: tuple(v) if isinstance(v, list) else v
+                      for k, v in json.loads(text).items() if k in fields})

@@ -261,7 +261,7 @@ class AutoChooser:
             now = self._cpu()
             memory = result.memory
             self.tally = self.tally.add(wall=wall, cpu_seconds=now - self._last_cpu,
-                                        footprint_mb=memory.get("footprint_mb"),
+                                        footprint_mb=memory and memory.footprint_mb,
                                         strained=starved(result), at_once=at_once)
             self._last_cpu = now
             choice = decide(self.tally, cores=self._cores(), memory_mb=self._memory_mb(),

@@ -22,7 +22,15 @@ from typing import Any
 
 from autograder.core.exercise import Exercise
 from autograder.core.report import RawReport, RawTest
-from autograder.core.results import NotRun, RunResult, TestResult, exact
+from autograder.core.results import (
+    Containment,
+    MemoryUse,
+    NotRun,
+    RunResult,
+    RunTiming,
+    TestResult,
+    exact,
+)
 from autograder.core.settings import RunSettings
 from autograder.grading import children
 from autograder.grading.capacity import machine_cores
@@ -109,7 +117,7 @@ def _grade_once(exercise: Exercise, submission: Path | None, *, hidden: bool,
     isolation = detect()
     if isolation.mode == "user":  # no mount namespace hides them: permissions must
         close_to_others(protected_paths(exercise.folder.parent.parent))
-    record, warnings = _record_folder(record)
+    record, warnings = record_folder(record)
     plan = _Plan.of(exercise, hidden)
     wanted = 1 if domain is not None else children_for(module_jobs, len(plan.modules),
                                                           machine_cores())
@@ -130,7 +138,8 @@ def _grade_once(exercise: Exercise, submission: Path | None, *, hidden: bool,
     # Each child's students run as the user of its domain.
     uids = [student_uid(lock.domain) for lock in locks] if isolation.own_user else None
     return dataclasses.replace(
-        result, isolation={**isolation.to_dict(), "bounds": bounds, "student_uids": uids},
+        result, isolation=Containment.from_dict(
+            {**isolation.to_dict(), "bounds": bounds, "student_uids": uids}),
         domains=tuple(lock.domain for lock in locks), processes=tuple(processes),
         student_uids=tuple(uids) if uids else None)
 
@@ -181,7 +190,7 @@ class _Plan:
         return [Path(os.path.relpath(m, root)).as_posix() for m in self.modules]
 
 
-def _record_folder(record: Path | None) -> tuple[Path | None, list[str]]:
+def record_folder(record: Path | None) -> tuple[Path | None, list[str]]:
     """The recordings' folder, made and absolute; None and a warning if it cannot be made
     (the grading goes on without recording)."""
     if record is None:
@@ -247,39 +256,25 @@ def _run(exercise: Exercise, submission: Path | None, plan: _Plan,
         ended = [children.end(child) for child in running]
     elapsed = time.monotonic() - started
     raw = merge(([e.raw for e in ended]), plan.order(exercise.folder))
-    result = _result(exercise, raw, ended, elapsed, all_tests=plan.all_tests)
-    timing = _timing(raw.data, min(e.launched for e in ended), elapsed)
-    memory = _memory(raw.data.get("memory"), footprint.peak_mb)
-    return dataclasses.replace(result, timing={**timing, "children": len(ended)},
-                               memory=memory), raw
+    result = verdict(exercise, raw, ended, elapsed, all_tests=plan.all_tests)
+    timing = _timing(raw.data, min(e.launched for e in ended), elapsed, len(ended))
+    memory = MemoryUse.of(raw.data.get("memory"), footprint.peak_mb)
+    return dataclasses.replace(result, timing=timing, memory=memory), raw
 
 
-def _memory(children_peaks: dict[str, float] | None,
-            footprint_mb: float | None) -> dict[str, float]:
-    """The results' ``memory``: the children's peak resident sizes, summed (an upper bound,
-    see :func:`autograder.grading.module_groups.merge`), and ``footprint_mb``, the peak of the
-    whole grading's summed PSS as sampled (:mod:`autograder.grading.footprint`), if any
-    sample was taken."""
-    memory = dict(children_peaks or {})
-    if footprint_mb is not None:
-        memory["footprint_mb"] = footprint_mb
-    return memory
-
-
-def _timing(data: dict[str, Any], launched: float, elapsed: float) -> dict[str, Any]:
-    """The whole grading's wall seconds: the children's start (from the first launch to
-    the first test: pytest, the plugin, collecting the tests), the tests (per module, see
-    :mod:`autograder.plugin.timing`; summed, so more than ``total`` when modules run at
-    once) and the total, from the grader's call. ``launched`` is when the first child was
-    started (the monotonic clock, the same in every process). ``sim_seconds``: each
-    test's simulation seconds to its verdict, by node id (see the reporter)."""
+def _timing(data: dict[str, Any], launched: float, elapsed: float,
+            children: int) -> RunTiming:
+    """The whole grading's wall seconds (:class:`~autograder.core.results.RunTiming`) from
+    the merged raw report. ``launched`` is when the first child was started (the monotonic
+    clock, the same in every process); the children's start runs from then to the first
+    test (pytest, the plugin, collecting the tests)."""
     modules = data.get("timing", {})
     first = data.get("first_test_at")
     child_start = None if first is None else round(max(0.0, first - launched), 3)
-    return {"child_start": child_start,
-            "tests": round(sum(m.get("total", 0.0) for m in modules.values()), 3),
-            "total": round(elapsed, 3), "modules": modules,
-            "sim_seconds": data.get("sim_seconds", {})}
+    return RunTiming(child_start=child_start,
+                     tests=round(sum(m.get("total", 0.0) for m in modules.values()), 3),
+                     total=round(elapsed, 3), modules=modules,
+                     sim_seconds=data.get("sim_seconds", {}), children=children)
 
 
 def _fault(exercise: Exercise, details: str, elapsed: float) -> RunResult:
@@ -339,7 +334,7 @@ def _refused(exercise: Exercise, message: str, elapsed: float) -> RunResult:
                      tests=(test,), pass_mark=exercise.pass_fraction, lang=get_language(),
                      execution_time=elapsed, refused=True,
                      # nothing ran; the shape it would have run in:
-                     isolation={**detect().to_dict(), "bounds": None, "student_uids": None})
+                     isolation=Containment.from_dict(detect().to_dict()))
 
 
 def _forged(exercise: Exercise, elapsed: float) -> RunResult:
@@ -355,7 +350,7 @@ def _forged(exercise: Exercise, elapsed: float) -> RunResult:
                      execution_time=elapsed, forged=True)
 
 
-def _result(exercise: Exercise, raw_report: RawReport, ended: Sequence[children.Ended],
+def verdict(exercise: Exercise, raw_report: RawReport, ended: Sequence[children.Ended],
             elapsed: float, all_tests: bool = True) -> RunResult:
     """The verdict on the merged report: each child's tests as that child ended (those of
     a child stopped at the time limit say so; a child that broke is the grader's fault)."""

@@ -8,6 +8,7 @@ file).  Labels carry the comment "test label" for translators.
 from __future__ import annotations
 
 import ast
+import tokenize
 from collections.abc import Collection, Iterator, Mapping
 from typing import IO, Any
 
@@ -19,7 +20,10 @@ def extract_tests(fileobj: IO[bytes], keywords: Mapping[str, Any],
                   options: Mapping[str, Any]) -> Iterator[tuple[int, str, Any, list[str]]]:
     source = fileobj.read()
     fileobj.seek(0)
-    yield from extract_python(fileobj, keywords, comment_tags, options)
+    try:
+        yield from extract_python(fileobj, keywords, comment_tags, options)
+    except tokenize.TokenError:  # an unclosed bracket: the calls before it, as pytest
+        return                   # will say what is wrong with the file
     try:
         tree = ast.parse(source)
     except SyntaxError:

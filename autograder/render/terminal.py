@@ -13,13 +13,19 @@ from __future__ import annotations
 
 import re
 import unicodedata
-from collections.abc import Collection, Iterable, Mapping
+from collections.abc import Collection, Iterable
 from pathlib import Path
-from typing import Any
 
 from babel.numbers import format_percent
 
-from autograder.core.results import RunResult, TestResult, as_decimal, number
+from autograder.core.results import (
+    Containment,
+    ProcessBounds,
+    RunResult,
+    TestResult,
+    as_decimal,
+    number,
+)
 from autograder.i18n import _, get_language, is_rtl, ngettext
 from autograder.i18n.text import CODE_SPAN, LRI, PDI, ltr_runs
 from autograder.render.verdict import core_label, core_lines
@@ -191,32 +197,32 @@ def _bound(kind: str | None, cgroup: str | None, controller: str, rlimit: str) -
     return _("nothing (no writable cgroup, no user of its own)")
 
 
-def isolation_line(isolation: Mapping[str, Any]) -> str:
+def isolation_line(isolation: Containment) -> str:
     """How the student's program was contained, and what bounded it, in one line."""
-    bounds = isolation.get("bounds") or {}
+    bounds = isolation.bounds or ProcessBounds()
     limits = _("processes bounded by {processes}, memory by {memory}").format(
-        processes=_bound(bounds.get("processes"), bounds.get("cgroup"), "pids", "RLIMIT_NPROC"),
-        memory=_bound(bounds.get("memory"), bounds.get("cgroup"), "memory", "RLIMIT_AS"))
-    mode = isolation.get("mode")
+        processes=_bound(bounds.processes, bounds.cgroup, "pids", "RLIMIT_NPROC"),
+        memory=_bound(bounds.memory, bounds.cgroup, "memory", "RLIMIT_AS"))
+    mode = isolation.mode
     if mode == "strict":
         return _("Isolation: strict (a user of its own, no network, the course hidden); "
                  "{limits}.").format(limits=limits)
     if mode == "user":
         return _("Isolation: by user, {reason}: a user of its own, the course closed to it, "
                  "but the network and the machine's processes in its reach; {limits}."
-                 ).format(reason=_(isolation.get("reason", "")), limits=limits)
+                 ).format(reason=_(isolation.reason), limits=limits)
     return "\n".join((
         _("Isolation: basic, {reason}; the program ran as the grader's user; {limits}."
-          ).format(reason=_(isolation.get("reason", "")), limits=limits),
+          ).format(reason=_(isolation.reason), limits=limits),
         _("Not an official grade: a program run as the grader's user could read the hidden "
           "tests and change these results.")))
 
 
-def containment_sentence(isolation: Mapping[str, Any]) -> str:
+def containment_sentence(isolation: Containment) -> str:
     """For students: in one sentence, whether their program was contained and why that
     matters (the grade stands for what their node did, and only that). The technical
     line (:func:`isolation_line`) is for instructors: ``--verbose`` and the JSON."""
-    if isolation.get("mode") in ("strict", "user"):
+    if isolation.mode in ("strict", "user"):
         return _("Your program ran contained, as a user of its own, so this grade stands for "
                  "what your node did and nothing else.")
     return _("Your program was not contained (it ran as the grader's own user), so it could "
@@ -235,7 +241,7 @@ def to_terminal(result: RunResult, color: bool = False, shown: Collection[str] =
         lines += ["", block]
     lines += ["", *score_lines(result, color)]
     isolation = result.isolation
-    if isolation:
+    if isolation is not None:
         lines.append(isolation_line(isolation) if verbose else containment_sentence(isolation))
     if result.grader_error:
         lines.append(_style(_("The autograder failed, tell your instructor."), "yellow", color,

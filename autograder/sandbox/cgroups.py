@@ -97,15 +97,16 @@ def _v1_folder(mount: Path, controller: str, name: str) -> Path:
     return mount / (f"{PARENT}-{name}" if controller == "cpu" else f"{PARENT}/{name}")
 
 
-def _write(path: Path, value: str) -> None:
-    # One write() per value: cgroupfs parses each write on its own.
+def write_control(path: Path, value: str) -> None:
+    """Write ``value`` to a cgroup control file in one ``write()``: cgroupfs parses each
+    write on its own. Raises OSError as the kernel refuses it (a busy controller)."""
     with open(path, "w") as fh:
         fh.write(value)
 
 
 def _try_write(path: Path, value: str) -> bool:
     try:
-        _write(path, value)
+        write_control(path, value)
     except OSError:
         return False
     return True
@@ -149,7 +150,7 @@ def _create_v1(root: Path, name: str, limits: Limits) -> tuple[list[Path], set[s
         path = _v1_folder(mount, controller, name)
         try:
             path.mkdir(parents=True, exist_ok=True)
-            _write(path / LIMIT_FILES["v1"][controller], values[controller])
+            write_control(path / LIMIT_FILES["v1"][controller], values[controller])
         except OSError:
             _rmdir(path)
             continue

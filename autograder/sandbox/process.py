@@ -182,12 +182,20 @@ def close_zygotes() -> None:
     """End this process's zygotes and wait for them (at exit): the CPU time of the programs
     they forked then counts in this process's children's, as an exec'd program's does, for
     whoever measures a grading's CPU (``grade-batch --jobs auto``, the benchmarks). A later
-    launch starts a new one."""
+    launch starts a new one, for a start-up that failed before too."""
     with _zygotes_lock:
         zygotes = list(_zygotes.values())
         _zygotes.clear()
+        _zygotes_failed.clear()
     for zygote in zygotes:
         zygote.close()
+
+
+def zygotes() -> list[Any]:
+    """This process's zygotes that started (each a
+    :class:`~autograder.sandbox.contained.zygote.Zygote`, alive or not)."""
+    with _zygotes_lock:
+        return list(_zygotes.values())
 
 
 def forked_peak_mb() -> float:
@@ -223,7 +231,7 @@ class LaunchFailed(GraderError):
 LAUNCH_TIMEOUT = 60.0
 
 
-class _Output:
+class BoundedOutput:
     """Collects a stream: keeps the first and last bytes up to a budget, counts the rest."""
 
     def __init__(self, budget: int) -> None:
@@ -283,7 +291,7 @@ class StudentProcess:
     limits: Limits
     popen: Any = None  # a subprocess.Popen, or a zygote's ForkedProcess
     cgroup: Cgroup | None = None
-    output: _Output | None = None
+    output: BoundedOutput | None = None
     uid: int | None = None
     namespaces: bool = True  # with ``uid``: strict isolation's namespaces, or none (user)
     hide: list[Path] = dataclasses.field(default_factory=list)
@@ -315,7 +323,7 @@ class StudentProcess:
             spec.update(uid=self.uid, namespaces=self.namespaces,
                         hide=[str(p) for p in self.hide], workdir_mb=self.workdir_mb)
         args = ["--ros-args", *self.ros_args]
-        self.output = _Output(self.limits.output_kb * 1024)
+        self.output = BoundedOutput(self.limits.output_kb * 1024)
         launcher_env = dict(self.env)
         launcher_env["PYTHONPATH"] = os.pathsep.join(
             p for p in (PACKAGE_PARENT, self.env.get("PYTHONPATH"))

@@ -3,32 +3,21 @@
 from __future__ import annotations
 
 import json
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 from click.testing import CliRunner
+from quiz_course import QUIZ_COURSE
 
 from autograder.cli.quiz import quiz_cli
 from autograder.quiz.model import load_quiz
 from autograder.quiz.render import question_views
 
 REPO = Path(__file__).resolve().parents[2]
-# The quizzes these tests read: a frozen copy, so that editing quizzes/ never breaks a
-# platform test (tests/fixtures/quiz_course/README.md).
-QUIZ_COURSE = Path(__file__).parents[1] / "fixtures" / "quiz_course"
 ERRORS = load_quiz(QUIZ_COURSE / "quizzes" / "error-handling.yaml").quiz
 
 
-@pytest.fixture(autouse=True)
-def _quiz_course(monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
-    """Commands that find quizzes by id find the fixture's."""
-    from autograder.i18n import translations
-
-    monkeypatch.setenv("AUTOGRADER_COURSE", str(QUIZ_COURSE))
-    translations.cache_clear()
-    yield
-    translations.cache_clear()
+pytestmark = pytest.mark.usefixtures("in_quiz_course")
 
 
 def _right_input(seed: str) -> str:

@@ -1,6 +1,7 @@
 """``autograder sim run --node``: a student's node started with the world as grading starts
 it. Simulation time starts only once the node is up, so two hand runs of one node in one
-world give the same trajectory; Ctrl-C stops both and leaves nothing behind."""
+world give the same trajectory; Ctrl-C stops both and leaves nothing behind. (The hand
+run's own parts: tests/commands/test_hand_run.py.)"""
 
 from __future__ import annotations
 
@@ -19,26 +20,11 @@ from click.testing import CliRunner
 from pasted import as_a_terminal_starts_it
 
 from autograder.cli import main
-from autograder.commands.hand_run import exercise_world, node_exercise
-from autograder.core.exercise import find_exercise
 
 REPO = Path(__file__).resolve().parents[2]
 NODES = REPO / "tests" / "fixtures" / "hand_node"
 FIRST = re.compile(r"first command at ([\d.]+) s \(pid (\d+)\)")
 WALL = 120.0  # generous wall-clock deadline for one hand run
-
-
-def test_a_file_named_like_an_exercises_is_that_exercises_node(tmp_path: Path) -> None:
-    mine = tmp_path / "velocity_governor.py"
-    assert node_exercise(mine, None).id == "parameter_validation"
-    assert node_exercise(tmp_path / "my_node.py", None) is None  # a plain node
-    assert node_exercise(tmp_path / "my_node.py", "timer_sync").node == "multi_rate_controller"
-
-
-def test_an_exercises_own_world_file_is_given_by_path() -> None:
-    assert exercise_world(find_exercise("parameter_validation")) == "empty_room"
-    world = Path(exercise_world(find_exercise("callback_groups")))
-    assert world.is_file() and world.name == "supervisor_room.yaml"
 
 
 def test_exercise_and_params_go_with_node() -> None:

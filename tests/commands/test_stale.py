@@ -56,6 +56,11 @@ def left_node(folder: Path, domain: int, user: int | None = None) -> subprocess.
     while user is not None and Path(f"/proc/{node.pid}").stat().st_uid != user:
         assert time.monotonic() < deadline, "setpriv never became the user"
         time.sleep(0.01)  # until setpriv has changed user: a condition, with a deadline
+    # Until the program runs: before its exec, /proc shows the parent's environment, which
+    # holds no ROS_DOMAIN_ID of the node's (a loaded machine once found no node there).
+    while IDLE[-1].encode() not in Path(f"/proc/{node.pid}/cmdline").read_bytes():
+        assert time.monotonic() < deadline, "the node never started"
+        time.sleep(0.01)
     return node
 
 

@@ -11,7 +11,7 @@ import os
 import subprocess
 import sys
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -21,20 +21,11 @@ from autograder.cli import main
 from autograder.core.exercise import find_exercise
 from autograder.core.source import SourceRefused, SourceSyntaxError, check_source
 from autograder.grading.run import grade
-from autograder.i18n import set_language
 
 EXERCISE = "parameter_validation"
 NODE = "velocity_governor.py"
 HEADER = "import rclpy\nfrom rclpy.node import Node\n\n"
 URDU = range(0x0600, 0x0700)
-
-
-@pytest.fixture(autouse=True)
-def _english() -> Iterator[None]:
-    """``--lang ur`` sets the process's language: each test starts in English again."""
-    set_language("en")
-    yield
-    set_language("en")
 
 
 def _latin1_comment(folder: Path) -> Path:

@@ -53,13 +53,6 @@ def raw_controls(text: str) -> set[str]:
             or c in BIDI or c in NOT_XML or unicodedata.category(c) == "Cs"}
 
 
-@pytest.fixture(autouse=True)
-def english():
-    set_language("en")
-    yield
-    set_language("en")
-
-
 # The function ------------------------------------------------------------------------------
 
 

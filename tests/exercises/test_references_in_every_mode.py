@@ -64,8 +64,8 @@ def graded(mode: str, tmp_path_factory: pytest.TempPathFactory) -> dict[str, Run
 @pytest.mark.parametrize("exercise", list_exercises(), ids=lambda e: e.id)
 def test_the_reference_keeps_full_marks(exercise, graded, mode):
     result = graded[exercise.id]
-    assert result.isolation["mode"] == mode
-    assert result.isolation["official"] is (mode == "user")
+    assert result.isolation.mode == mode
+    assert result.isolation.official is (mode == "user")
     assert result.grader_error is None, result.grader_details
     assert result.score == result.max_score, [(t.name, t.message) for t in result.tests
                                               if not t.passed]
@@ -77,7 +77,7 @@ def test_a_known_bad_variant_loses_the_same_tests_where_grades_are_official(exer
     if mode != "user":
         pytest.skip("basic isolation's grades are not official")
     result, variant = graded[f"{exercise.id}/bad"], _known_bad(exercise)
-    assert result.isolation["mode"] == "user"
+    assert result.isolation.mode == "user"
     assert result.grader_error is None, result.grader_details
     assert failed_tests(result) == variant.loses, (variant.name, failures(result))
     assert not result.passed

@@ -15,7 +15,7 @@ from autograder.core.report import RawReport, RawTest
 from autograder.core.results import RunResult
 from autograder.grading.children import Child, Ended
 from autograder.grading.module_groups import children_for, find_modules, merge, share_out
-from autograder.grading.run import GRADER_FAULT, _result
+from autograder.grading.run import GRADER_FAULT, verdict
 
 PUBLIC, HIDDEN_A, HIDDEN_B = "tests/public/test_p.py", "tests/hidden/test_a.py", \
     "tests/hidden/test_b.py"
@@ -150,16 +150,17 @@ def test_a_grading_runs_its_modules_in_two_children_on_two_domains(
     assert [t.nodeid for t in result.tests] == _collected(exercise.folder)
     domains = result.domains
     assert len(domains) == 2 and len(set(domains)) == 2
-    assert result.timing["children"] == 2
+    assert result.timing is not None and result.timing.children == 2
     modules = {t.nodeid.split("::")[0] for t in result.tests}
-    assert set(result.timing["modules"]) == modules
+    assert set(result.timing.modules) == modules
     assert set(result.pacing) == {m.rpartition("/")[2] for m in modules}
     assert set(result.recordings) == set(result.pacing)
     # The tree's PSS: this process, two children and a student each at a time, each
     # counting at most its resident size (PSS divides the pages it shares).
     memory = result.memory
+    assert memory is not None and memory.footprint_mb is not None
     own_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-    assert 0 < memory["footprint_mb"] < memory["total_mb"] + own_mb
+    assert 0 < memory.footprint_mb < (memory.total_mb or 0.0) + own_mb
     # The children kept their bytecode (hidden tests' included) in the user's cache, and
     # wrote none beside the course's sources.
     cached = tmp_path / "rclpy-autograder" / "pycache"
@@ -191,7 +192,7 @@ def _ended(*tests: RawTest, returncode: int | None = 1, timed_out: bool = False,
 
 def _outcome(*ended: Ended) -> RunResult:
     raw = merge([e.raw for e in ended], ORDER)
-    return _result(load_exercise(SHOUT), raw, ended, 1.0)
+    return verdict(load_exercise(SHOUT), raw, ended, 1.0)
 
 
 def test_a_child_stopped_at_the_time_limit_says_so_for_its_own_tests_only() -> None:

@@ -1,42 +1,21 @@
-"""The Babel extractor, and ``autograder i18n extract | update | compile | check``."""
+"""Extracting, updating, compiling and checking the catalogs (through ``autograder i18n
+extract | update | compile | check``). The Babel extractors themselves:
+tests/quiz/test_extract.py; the command's own output and errors: tests/cli/test_i18n.py."""
 
 from __future__ import annotations
 
-import io
 import shutil
 from pathlib import Path
 
 import pytest
 from babel.messages.pofile import read_po
 from click.testing import CliRunner
+from quiz_course import QUIZ_COURSE
 
 from autograder.cli.i18n import i18n_cli
 from autograder.i18n import translations
-from autograder.quiz.extract import extract_exercise, extract_quiz
 
 REPO = Path(__file__).resolve().parents[2]
-# The quizzes these tests read: a frozen copy, so that editing quizzes/ never breaks a
-# platform test (tests/fixtures/quiz_course/README.md).
-QUIZ_COURSE = Path(__file__).parents[1] / "fixtures" / "quiz_course"
-ALL_TITLE = "Part 2 quiz: Python and ROS 2 with rclpy"
-
-
-def _extract(func: object, path: Path) -> list[tuple]:
-    with path.open("rb") as fh:
-        return list(func(fh, {}, (), {}))  # type: ignore[operator]
-
-
-def test_quiz_extractor_gives_contexts_and_real_lines() -> None:
-    path = QUIZ_COURSE / "quizzes" / "part2-rclpy.yaml"
-    found = {msg[1]: (line, msg[0]) for line, func, msg, _c in _extract(extract_quiz, path)}
-    lines = path.read_text().splitlines()
-    line, ctx = found["What is the Global Interpreter Lock (GIL)?"]
-    assert ctx == "quiz:rclpy-part2:gil:text"
-    assert "What is the Global Interpreter Lock" in lines[line - 1]
-    assert found["None of the above"][1] == "quiz:rclpy-part2:shared-resources:options.none"
-    # Code-only options are not translated: nothing to extract.
-    assert "`ReentrantCallbackGroup`" not in found
-    assert all(func == "pgettext" for _l, func, _m, _c in _extract(extract_quiz, path))
 
 
 def test_identical_strings_in_different_questions_stay_separate(tmp_path: Path) -> None:
@@ -50,15 +29,6 @@ def test_identical_strings_in_different_questions_stay_separate(tmp_path: Path) 
     assert contexts == ["quiz:callback-groups:gil-effect:options.none",
                         "quiz:parameter-validation:range:options.none",
                         "quiz:rclpy-part2:shared-resources:options.none"]
-
-
-def test_exercise_extractor(tmp_path: Path) -> None:
-    path = tmp_path / "assignments" / "timers" / "exercise.yaml"
-    path.parent.mkdir(parents=True)
-    path.write_text("id: timers\nkind: exercise\ntitle: Timers\nsummary: Two timers.\n")
-    found = [(line, msg) for line, _f, msg, _c in _extract(extract_exercise, path)]
-    assert found == [(3, ("exercise:timers:title", "Timers")),
-                     (4, ("exercise:timers:summary", "Two timers."))]
 
 
 @pytest.fixture
@@ -140,31 +110,6 @@ def test_update_keeps_translations_and_marks_changed_strings_fuzzy(course: Path)
     assert entry is not None and entry.fuzzy  # lint fails until a translator checks it
     code, output = _run("check")
     assert code == 1 and "is fuzzy" in output
-
-
-def test_malformed_catalog_and_quiz_are_one_line_errors(course: Path) -> None:
-    _run("extract")
-    _run("update")
-    po = course / "locales" / "ur" / "LC_MESSAGES" / "content.po"
-    po.write_text(po.read_text() + '\nmsgid "broken\n')
-    code, output = _run("compile")
-    assert code == 2 and output.strip().startswith(f"Error: {po}:")
-    quiz = course / "quizzes" / "part2-rclpy.yaml"
-    quiz.write_text(quiz.read_text().replace("type: single", "type: essay", 1))
-    code, output = _run("extract")
-    assert code == 2 and "part2-rclpy.yaml:8: questions[callback-groups-purpose].type" in output
-    assert len(output.strip().splitlines()) == 1
-
-
-def test_babel_accepts_our_extractor_by_module_path() -> None:
-    # babel.cfg names the extractor by module path, so pybabel works from a checkout.
-    from babel.messages.extract import extract
-
-    source = QUIZ_COURSE / "quizzes" / "part2-rclpy.yaml"
-    messages = list(extract("autograder.quiz.extract:extract_quiz",
-                            io.BytesIO(source.read_bytes())))
-    lineno, message, _comments, context = messages[0]
-    assert (lineno, context, message) == (3, "quiz:rclpy-part2:title", ALL_TITLE)
 
 
 def test_extracting_after_a_content_change_touches_only_what_changed(course: Path) -> None:

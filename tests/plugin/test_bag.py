@@ -28,7 +28,7 @@ from std_msgs.msg import String
 
 from autograder.core.results import RunResult
 from autograder.core.settings import RunSettings
-from autograder.grading.run import _record_folder
+from autograder.grading.run import record_folder
 from autograder.plugin.bag import attach_probe, close_bag, open_bag
 from autograder.plugin.probe import Probe
 from autograder.plugin.reporter import GradingReporter
@@ -146,9 +146,9 @@ def test_a_bag_that_cannot_be_made_is_a_warning_not_a_failure(tmp_path: Path) ->
 def test_the_grader_warns_when_the_folder_cannot_be_made(tmp_path: Path) -> None:
     blocker = tmp_path / "a_file"
     blocker.write_text("")
-    folder, warnings = _record_folder(blocker / "bags")
+    folder, warnings = record_folder(blocker / "bags")
     assert folder is None and len(warnings) == 1
-    assert _record_folder(tmp_path / "new" / "bags") == ((tmp_path / "new" / "bags"), [])
+    assert record_folder(tmp_path / "new" / "bags") == ((tmp_path / "new" / "bags"), [])
     assert (tmp_path / "new" / "bags").is_dir()
 
 

@@ -15,7 +15,7 @@ from typing import Any
 
 import pytest
 
-from autograder.core.output_budget import CUT, MESSAGE_BYTES
+from autograder.core.output_budget import CUT, DETAILS_BYTES, MESSAGE_BYTES
 from autograder.core.settings import RunSettings
 from autograder.core.signing import Forged, verify
 
@@ -358,12 +358,17 @@ def test_a_long_message_is_cut_to_a_few_kilobytes(pytester: pytest.Pytester) -> 
         from autograder.core.errors import StudentFailure
 
         def test_chatty():
-            raise StudentFailure("start" + "x" * 100_000 + "end")
+            raise StudentFailure("start" + "x" * 1_000_000 + "end", "a short hint")
     ''')
-    message = tests["test_chatty"]["message"]
+    entry = tests["test_chatty"]
+    message = entry["message"]
     assert message.startswith("start") and message.endswith("end")
     assert f"\n{CUT}\n" in message
     assert len(message.encode()) <= MESSAGE_BYTES + len(f"\n{CUT}\n".encode())
+    assert entry["hint"] == "a short hint"  # short enough: kept whole
+    # The traceback holds the message too: it is cut to its own, larger, budget.
+    assert "x" * 1000 in entry["details"] and entry["details"].rstrip().endswith("end")
+    assert len(entry["details"].encode()) <= DETAILS_BYTES + len(f"\n{CUT}\n".encode())
 
 
 def test_without_exercise_the_plugin_writes_nothing(pytester: pytest.Pytester) -> None:

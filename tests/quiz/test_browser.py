@@ -4,13 +4,13 @@ from __future__ import annotations
 
 import contextlib
 import json
-import threading
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import pytest
 from browser import chromium_page, fonts_used, ink
+from quiz_course import QUIZ_COURSE
 
 from autograder.quiz.catalog import load_all
 from autograder.quiz.model import Question, Quiz, load_quiz
@@ -19,31 +19,9 @@ from autograder.quiz.scoring import check_answers, key_answers, score
 from autograder.quiz.server import QuizServer
 
 REPO = Path(__file__).resolve().parents[2]
-# The quizzes these tests read: a frozen copy, so that editing quizzes/ never breaks a
-# platform test (tests/fixtures/quiz_course/README.md).
-QUIZ_COURSE = Path(__file__).parents[1] / "fixtures" / "quiz_course"
 
 
-@pytest.fixture(autouse=True)
-def _quiz_course(monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
-    """Pages are translated with the fixture's own content catalog."""
-    from autograder.i18n import translations
-
-    monkeypatch.setenv("AUTOGRADER_COURSE", str(QUIZ_COURSE))
-    translations.cache_clear()
-    yield
-    translations.cache_clear()
-
-
-@pytest.fixture
-def server() -> Iterator[QuizServer]:
-    srv = QuizServer(load_all(QUIZ_COURSE), port=0)
-    thread = threading.Thread(target=srv.serve_forever, daemon=True)
-    thread.start()
-    yield srv
-    srv.shutdown()
-    srv.server_close()
-    thread.join(timeout=5)
+pytestmark = pytest.mark.usefixtures("in_quiz_course")
 
 
 def test_serve_pick_urdu_answer_submit_see_verdict(server: QuizServer) -> None:

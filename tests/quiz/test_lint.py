@@ -3,30 +3,13 @@
 from __future__ import annotations
 
 import re
-import shutil
 from pathlib import Path
 
-import pytest
 from click.testing import CliRunner
 
 from autograder.cli.quiz import quiz_cli
-from autograder.i18n import translations
 
 REPO = Path(__file__).resolve().parents[2]
-# The quizzes these tests read: a frozen copy, so that editing quizzes/ never breaks a
-# platform test (tests/fixtures/quiz_course/README.md).
-QUIZ_COURSE = Path(__file__).parents[1] / "fixtures" / "quiz_course"
-
-
-@pytest.fixture
-def course(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
-    shutil.copytree(QUIZ_COURSE / "quizzes", tmp_path / "quizzes")
-    shutil.copytree(QUIZ_COURSE / "locales", tmp_path / "locales")
-    monkeypatch.setenv("AUTOGRADER_COURSE", str(tmp_path))
-    monkeypatch.setenv("AUTOGRADER_LOCALES", str(tmp_path / "locales"))
-    translations.cache_clear()
-    yield tmp_path
-    translations.cache_clear()
 
 
 def _lint() -> tuple[int, list[str]]:

@@ -2,22 +2,18 @@
 
 from __future__ import annotations
 
-import shutil
 from pathlib import Path
 
 import pytest
 from click.testing import CliRunner
+from quiz_course import QUIZ_COURSE
 
 from autograder.cli.quiz import quiz_cli
 from autograder.core.errors import ContentError
-from autograder.i18n import translations
 from autograder.quiz.catalog import list_quizzes, load_all
 from autograder.quiz.model import load_quiz
 
 REPO = Path(__file__).resolve().parents[2]
-# The quizzes these tests read: a frozen copy, so that editing quizzes/ never breaks a
-# platform test (tests/fixtures/quiz_course/README.md).
-QUIZ_COURSE = Path(__file__).parents[1] / "fixtures" / "quiz_course"
 
 GOOD = """\
 id: tiny
@@ -31,18 +27,6 @@ questions:
       - {id: b, text: B}
     answer: a
 """
-
-
-@pytest.fixture
-def course(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
-    """A copy of the course's quizzes and catalogs that a test may break."""
-    shutil.copytree(QUIZ_COURSE / "quizzes", tmp_path / "quizzes")
-    shutil.copytree(QUIZ_COURSE / "locales", tmp_path / "locales")
-    monkeypatch.setenv("AUTOGRADER_COURSE", str(tmp_path))
-    monkeypatch.setenv("AUTOGRADER_LOCALES", str(tmp_path / "locales"))
-    translations.cache_clear()
-    yield tmp_path
-    translations.cache_clear()
 
 
 def test_shipped_quizzes_load() -> None:

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import pytest
 from click.testing import CliRunner
+from quiz_course import QUIZ_COURSE
 
 from autograder.cli.quiz import quiz_cli
 from autograder.i18n import translations
@@ -17,9 +18,6 @@ from autograder.quiz.scoring import score
 from autograder.quiz.shuffle import option_order
 
 REPO = Path(__file__).resolve().parents[2]
-# The quizzes these tests read: a frozen copy, so that editing quizzes/ never breaks a
-# platform test (tests/fixtures/quiz_course/README.md).
-QUIZ_COURSE = Path(__file__).parents[1] / "fixtures" / "quiz_course"
 PART2 = load_quiz(QUIZ_COURSE / "quizzes" / "part2-rclpy.yaml").quiz
 ERRORS = load_quiz(QUIZ_COURSE / "quizzes" / "error-handling.yaml").quiz
 

@@ -3,12 +3,12 @@
 from __future__ import annotations
 
 import json
-from collections.abc import Iterator
 from fractions import Fraction
 from pathlib import Path
 
 import pytest
 from click.testing import CliRunner
+from quiz_course import QUIZ_COURSE
 
 from autograder.cli.quiz import quiz_cli
 from autograder.core.errors import ContentError
@@ -17,21 +17,10 @@ from autograder.quiz.model import load_quiz
 from autograder.quiz.scoring import key_answers, pass_summary, read_answers, score
 
 REPO = Path(__file__).resolve().parents[2]
-# The quizzes these tests read: a frozen copy, so that editing quizzes/ never breaks a
-# platform test (tests/fixtures/quiz_course/README.md).
-QUIZ_COURSE = Path(__file__).parents[1] / "fixtures" / "quiz_course"
 PART2 = QUIZ_COURSE / "quizzes" / "part2-rclpy.yaml"
 
 
-@pytest.fixture(autouse=True)
-def _quiz_course(monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
-    """Commands that find quizzes by id find the fixture's."""
-    from autograder.i18n import translations
-
-    monkeypatch.setenv("AUTOGRADER_COURSE", str(QUIZ_COURSE))
-    translations.cache_clear()
-    yield
-    translations.cache_clear()
+pytestmark = pytest.mark.usefixtures("in_quiz_course")
 
 
 def _quiz(n: int, pass_mark: str = "") -> object:

@@ -3,33 +3,16 @@
 from __future__ import annotations
 
 import re
-import threading
 import urllib.error
 import urllib.parse
 import urllib.request
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
-from autograder.quiz.catalog import load_all
 from autograder.quiz.server import QuizServer
 
 REPO = Path(__file__).resolve().parents[2]
-# The quizzes these tests read: a frozen copy, so that editing quizzes/ never breaks a
-# platform test (tests/fixtures/quiz_course/README.md).
-QUIZ_COURSE = Path(__file__).parents[1] / "fixtures" / "quiz_course"
-
-
-@pytest.fixture
-def server() -> Iterator[QuizServer]:
-    srv = QuizServer(load_all(QUIZ_COURSE), port=0)
-    thread = threading.Thread(target=srv.serve_forever, daemon=True)
-    thread.start()
-    yield srv
-    srv.shutdown()
-    srv.server_close()
-    thread.join(timeout=5)
 
 
 def _get(url: str) -> str:

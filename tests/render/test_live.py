@@ -9,7 +9,6 @@ from fractions import Fraction
 import pytest
 
 from autograder.core.results import TestResult
-from autograder.i18n import set_language
 from autograder.render.live import LiveLines, terminal_style
 
 CLEAR = "\r\x1b[2K"
@@ -26,11 +25,6 @@ class Clock:
 
     def __call__(self) -> float:
         return self.now
-
-
-@pytest.fixture(autouse=True)
-def english():
-    set_language("en")
 
 
 def test_plain_lines_only_as_tests_end():

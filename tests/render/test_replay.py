@@ -14,7 +14,6 @@ import pytest
 from recorded_runs import a_test, recorded
 
 from autograder.core.results import RunResult
-from autograder.i18n import set_language
 from autograder.render.html import to_html
 from autograder.render.replay import figures
 from sim.worldfile import load_world
@@ -34,13 +33,6 @@ def result() -> RunResult:
                   "test_faulty.py": recorded("obstacles", 10)}
     return RunResult("exercise", "parameter_validation", "A velocity governor", tests,
                      recordings=recordings)
-
-
-@pytest.fixture(autouse=True)
-def english():
-    set_language("en")
-    yield
-    set_language("en")
 
 
 def _figures(page: str) -> list[str]:

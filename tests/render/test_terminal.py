@@ -4,7 +4,6 @@ warning when `sim drive` bypasses the student's node."""
 
 from __future__ import annotations
 
-from collections.abc import Iterator
 from fractions import Fraction
 from typing import Any
 
@@ -13,20 +12,12 @@ from click.testing import CliRunner
 
 import sim.cli
 from autograder.cli import main
-from autograder.core.results import RunResult, TestResult
-from autograder.i18n import set_language
+from autograder.core.results import Containment, RunResult, TestResult
 from autograder.render.html import to_html
 from autograder.render.terminal import to_terminal
 from autograder.sandbox.isolation import Isolation
 
 BOUNDS = {"cgroup": None, "processes": None, "memory": None}
-
-
-@pytest.fixture(autouse=True)
-def _english() -> Iterator[None]:
-    set_language("en")
-    yield
-    set_language("en")
 
 
 def _result(**fields: Any) -> RunResult:
@@ -36,9 +27,10 @@ def _result(**fields: Any) -> RunResult:
                      tests=(test,), **fields)
 
 
-def _isolation(mode: str) -> dict[str, Any]:
+def _isolation(mode: str) -> Containment:
     reason = "" if mode == "strict" else "the grader does not run as root"
-    return {**Isolation(mode, reason).to_dict(), "bounds": BOUNDS}  # type: ignore[arg-type]
+    return Containment.from_dict(
+        {**Isolation(mode, reason).to_dict(), "bounds": BOUNDS})  # type: ignore[arg-type]
 
 
 @pytest.mark.parametrize(("mode", "sentence"), [

@@ -152,14 +152,14 @@ def test_v2_refused_subtree_control_keeps_the_leaf_without_limits(v2_root: Path)
 
 def test_v2_a_refused_controller_does_not_cost_the_other(
         v2_root: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    write = cgroups._write
+    write = cgroups.write_control
 
     def refuse_memory(path: Path, value: str) -> None:
         if path.name == "cgroup.subtree_control" and "memory" in value:
             raise OSError(errno.EBUSY, "Device or resource busy")
         write(path, value)
 
-    monkeypatch.setattr(cgroups, "_write", refuse_memory)
+    monkeypatch.setattr(cgroups, "write_control", refuse_memory)
     group = Cgroup("run-a", LIMITS)
     leaf = v2_root / "autograder" / "run-a"
     assert group.controllers == {"pids", "cpu"}

@@ -256,7 +256,7 @@ def test_modules_beside_the_node_run_only_as_the_student(graded):
     assert "ROOT CODE RAN" not in result.log
     importers = re.findall(r"^SHADOW (\w+) IMPORTED AS UID (\d+)$", result.log, re.M)
     assert {name for name, _uid in importers} <= {"json"}  # the node's own imports only
-    if result.isolation["mode"] == "strict":
+    if result.isolation.mode == "strict":
         assert {int(uid) for _name, uid in importers} <= set(result.student_uids or ())
 
 
@@ -314,7 +314,7 @@ def test_without_cgroups_a_daemon_still_ends_with_the_program(course, monkeypatc
     monkeypatch.setenv("AUTOGRADER_CGROUP_ROOT", "/nonexistent")
     result = grade(course, CORPUS / "detached_daemon")
     assert result.grader_error is None
-    assert result.isolation["bounds"]["cgroup"] is None  # it really had none
+    assert result.isolation.bounds.cgroup is None  # it really had none
     assert re.search(r"^STUDENT UID \d+$", result.log, re.M), "the daemon started"
     assert leftovers(result) == []
     from autograder.sandbox.sweep import user_processes
@@ -329,9 +329,9 @@ def test_runs_as_its_own_user_where_strict(graded):
     isolation, and the results say why."""
     result = graded["detached_daemon"][0]
     isolation = result.isolation
-    assert isolation["mode"] == detect().mode
+    assert isolation.mode == detect().mode
     seen = {int(uid) for uid in re.findall(r"^STUDENT UID (\d+)$", result.log, re.M)}
-    if isolation["mode"] == "strict":
+    if isolation.mode == "strict":
         assert result.student_uid is not None
         # Test modules run in children of their own, each with its domain's user.
         assert seen and seen <= set(result.student_uids or ())
@@ -339,7 +339,7 @@ def test_runs_as_its_own_user_where_strict(graded):
     else:
         assert result.student_uid is None
         assert seen == {os.getuid()}
-        assert isolation["reason"]  # the results say why
+        assert isolation.reason  # the results say why
 
 
 def test_output_that_lies_shows_as_text(graded):

@@ -16,6 +16,7 @@ from pathlib import Path
 import pytest
 
 from autograder.core.report import RawReport
+from autograder.core.results import Containment
 from autograder.grading import children
 from autograder.grading.children import Child, Watchers
 from autograder.render.terminal import isolation_line
@@ -36,12 +37,16 @@ def test_only_a_user_of_its_own_gives_official_grades():
     assert Isolation("user").to_dict()["network"] is True  # said, not hidden
 
 
+def _contained(isolation: Isolation) -> Containment:
+    """What the results say of a grading in this shape, bounded by rlimits alone."""
+    return Containment.from_dict({**isolation.to_dict(), "bounds": BOUNDS})
+
+
 def test_the_terminal_says_which_shape_and_whether_the_grade_is_official():
-    strict = isolation_line({**Isolation("strict").to_dict(), "bounds": BOUNDS})
-    user = isolation_line({**Isolation("user", "namespaces are not allowed here (an "
-                                       "unprivileged container?)").to_dict(), "bounds": BOUNDS})
-    basic = isolation_line({**Isolation("basic", "the grader does not run as root").to_dict(),
-                            "bounds": BOUNDS})
+    strict = isolation_line(_contained(Isolation("strict")))
+    user = isolation_line(_contained(Isolation(
+        "user", "namespaces are not allowed here (an unprivileged container?)")))
+    basic = isolation_line(_contained(Isolation("basic", "the grader does not run as root")))
     assert strict.startswith("Isolation: strict") and "official" not in strict
     assert user.startswith("Isolation: by user, namespaces are not allowed here")
     assert "the network and the machine's processes in its reach" in user
@@ -59,6 +64,12 @@ def test_isolation_by_user_keeps_fast_dds_on_loopback():
     assert text.count("<address>127.0.0.1</address>") == 2  # the allowlist, the peer
 
 
+def _stopped(pid: int) -> bool:
+    """Whether the kernel shows process ``pid`` stopped (``T`` in its stat)."""
+    with open(f"/proc/{pid}/stat", "rb") as stat:
+        return stat.read().rpartition(b")")[2].split()[0] == b"T"
+
+
 def test_a_stopped_grading_is_the_graders_failure(tmp_path):
     """A program of the grader's own user (basic isolation) may SIGSTOP the pytest child
     to read its memory at leisure: the grader ends that child and calls the grading its
@@ -68,7 +79,7 @@ def test_a_stopped_grading_is_the_graders_failure(tmp_path):
     try:
         process.send_signal(signal.SIGSTOP)
         deadline = time.monotonic() + 10
-        while not children._stopped(process.pid):
+        while not _stopped(process.pid):
             assert time.monotonic() < deadline, "the process never showed as stopped"
             time.sleep(0.01)
         log = tmp_path / "pytest.log"

@@ -1,32 +1,22 @@
-"""Nothing of the student's is run, imported or followed by a privileged process of the
-grader (issue 28): modules named like the standard library's beside the node, links,
-devices and FIFOs in a submission, and what a program leaves behind for its user."""
+"""Nothing of the student's is run or imported by a privileged process of the grader
+(issue 28): modules named like the standard library's beside the node. What a program
+leaves behind for its user, swept: tests/sandbox/test_sweep.py. Links, devices and FIFOs
+in a submission, never followed or read: tests/core/test_submission.py."""
 
 from __future__ import annotations
 
 import ctypes
 import os
-import shutil
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
-from click.testing import CliRunner
 
-from autograder.cli import main
 from autograder.core.exercise import Limits
-from autograder.core.submission import (
-    MAX_FILE_BYTES,
-    MAX_MODULES,
-    SubmissionRefused,
-    check,
-    stage,
-)
-from autograder.sandbox.isolation import detect, student_uid
+from autograder.sandbox.isolation import detect
 from autograder.sandbox.privileged import SAFE_CWD, module_command
 from autograder.sandbox.process import student_process
-from autograder.sandbox.sweep import is_student_uid, kill_user, sweep_user, user_ipc
 
 REPO = Path(__file__).resolve().parents[2]
 COURSE = REPO / "tests" / "fixtures" / "mini_course"
@@ -35,8 +25,6 @@ SHADOWS = ("json", "ctypes", "resource", "sitecustomize", "usercustomize", "runp
 
 strict_only = pytest.mark.skipif(not detect().strict,
                                  reason=f"needs strict isolation: {detect().reason}")
-root_only = pytest.mark.skipif(os.geteuid() != 0 or shutil.which("setpriv") is None,
-                               reason="needs root and setpriv to act as a student's user")
 
 
 # -- a privileged Python never imports the student's modules --------------------------
@@ -86,115 +74,6 @@ def test_an_isolated_command_ignores_the_folder_it_starts_in(tmp_path):
     plain = subprocess.run([sys.executable, "-c", "import json, runpy"], capture_output=True,
                            text=True, timeout=60, cwd=tmp_path)
     assert "SHADOW json IMPORTED" in plain.stdout  # the test can fail
-
-
-# -- submissions are read, never followed ---------------------------------------------
-def _submission(tmp_path: Path, name: str = "sub") -> Path:
-    folder = tmp_path / name
-    folder.mkdir()
-    shutil.copy(SOLUTION, folder / "shouter.py")
-    return folder
-
-
-def test_a_regular_submission_is_staged_with_its_modules(tmp_path):
-    folder = _submission(tmp_path)
-    (folder / "helper.py").write_text("X = 1\n")
-    (folder / "notes.txt").write_text("not python\n")
-    staged = stage(folder / "shouter.py", "shouter.py", tmp_path / "staged")
-    assert sorted(p.name for p in staged.parent.iterdir()) == ["helper.py", "shouter.py"]
-    assert staged.read_bytes() == SOLUTION.read_bytes()
-    assert not any(p.is_symlink() for p in staged.parent.iterdir())
-
-
-def _linked_node(folder: Path, target: str) -> None:
-    (folder / "shouter.py").unlink()
-    (folder / "shouter.py").symlink_to(target)
-
-
-@pytest.mark.parametrize(("make", "expected"), [
-    (lambda f: _linked_node(f, str(SOLUTION)), "shouter.py is a symbolic link"),
-    (lambda f: _linked_node(f, "/dev/zero"), "shouter.py is a symbolic link"),
-    (lambda f: _linked_node(f, "/nonexistent"), "shouter.py is a symbolic link"),
-    (lambda f: (f / "leak.py").symlink_to("/etc/shadow"), "leak.py is a symbolic link"),
-    (lambda f: (f / "other.py").symlink_to(SOLUTION), "other.py is a symbolic link"),
-    (lambda f: ((f / "shouter.py").unlink(), os.mkfifo(f / "shouter.py")),
-     "shouter.py is a FIFO"),
-    (lambda f: os.mkfifo(f / "pipe.py"), "pipe.py is a FIFO"),
-    (lambda f: (f / "big.py").write_bytes(b"#" * (MAX_FILE_BYTES + 1)),
-     "big.py is larger than"),
-    (lambda f: [(f / f"m{i}.py").write_text("") for i in range(MAX_MODULES + 1)],
-     "Python files beside your node"),
-])
-def test_what_the_grader_will_not_read_is_refused_by_name(tmp_path, make, expected):
-    folder = _submission(tmp_path)
-    make(folder)
-    with pytest.raises(SubmissionRefused, match=expected):
-        check(folder, "shouter.py")
-    with pytest.raises(SubmissionRefused, match=expected):
-        stage(folder / "shouter.py", "shouter.py", tmp_path / "staged")
-    assert not any((tmp_path / "staged").glob("*")) if (tmp_path / "staged").exists() else True
-
-
-def test_a_device_given_as_the_node_is_refused():
-    with pytest.raises(SubmissionRefused, match="zero is a device"):
-        check(Path("/dev/zero"), "shouter.py")
-
-
-@pytest.mark.parametrize("command", ["check", "grade"])
-def test_the_cli_refuses_a_linked_submission_as_the_students_error(tmp_path, monkeypatch,
-                                                                   command):
-    """Exit 2 and one plain line, before any grading: never "the autograder failed"."""
-    monkeypatch.setenv("AUTOGRADER_COURSE", str(COURSE))
-    folder = _submission(tmp_path)
-    (folder / "leak.py").symlink_to("/etc/shadow")
-    result = CliRunner().invoke(main, [command, "shout", str(folder)])
-    assert result.exit_code == 2, result.output
-    assert "leak.py is a symbolic link: submit the file itself" in result.output
-    assert "autograder failed" not in result.output
-
-
-def test_a_fifo_as_the_node_does_not_hang_the_cli(tmp_path, monkeypatch):
-    monkeypatch.setenv("AUTOGRADER_COURSE", str(COURSE))
-    folder = _submission(tmp_path)
-    (folder / "shouter.py").unlink()
-    os.mkfifo(folder / "shouter.py")  # opening it for reading would block without O_NONBLOCK
-    result = CliRunner().invoke(main, ["check", "shout", str(folder)])
-    assert result.exit_code == 2
-    assert "shouter.py is a FIFO, not a regular file" in result.output
-
-
-# -- a student's user leaves nothing behind --------------------------------------------
-def test_only_students_own_users_are_swept():
-    assert is_student_uid(student_uid(10)) and is_student_uid(student_uid(101))
-    for uid in (0, os.getuid(), 1000, 65534, student_uid(0) - 1):
-        assert not is_student_uid(uid)
-        with pytest.raises(ValueError):
-            kill_user(uid)
-
-
-@root_only
-def test_the_sweep_ends_a_users_processes_its_ipc_and_its_scratch_files(tmp_path):
-    """A daemon in a session of its own, a SysV segment and a file in /dev/shm, all of a
-    student's user and outside any process group or cgroup the grader knows: swept."""
-    uid = student_uid(230)  # a domain no grading reserves
-    code = ("import ctypes, os, time\n"
-            "libc = ctypes.CDLL(None)\n"
-            "print(libc.shmget(0x5A1A0000 + os.getpid() % 0x10000, 4096, 0o1666), flush=True)\n"
-            f"open('/dev/shm/autograder-sweep-test-{uid}', 'w').write('x')\n"
-            "if os.fork() == 0:\n"
-            "    os.setsid()\n"
-            "    time.sleep(600)\n"
-            "os._exit(0)\n")
-    subprocess.run(["setpriv", f"--reuid={uid}", f"--regid={uid}", "--clear-groups",
-                    sys.executable, "-I", "-c", code], check=True, cwd="/", timeout=60)
-    from autograder.sandbox.sweep import user_processes
-
-    assert user_processes(uid), "the daemon runs"
-    assert user_ipc(uid), "the segment exists"
-    assert sweep_user(uid)
-    assert user_processes(uid) == []
-    assert user_ipc(uid) == []
-    assert not Path(f"/dev/shm/autograder-sweep-test-{uid}").exists()
 
 
 @strict_only

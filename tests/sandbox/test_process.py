@@ -145,28 +145,6 @@ def test_a_reliable_stop_is_acknowledged_within_the_wait(tmp_path):
         publisher.output_text()
 
 
-def test_user_tasks_counts_threads_as_rlimit_nproc_does(tmp_path):
-    """Without a uid of its own, a student's RLIMIT_NPROC is what its user already runs plus
-    its own allowance, so the count is of threads (as RLIMIT_NPROC counts), by real uid."""
-    from autograder.sandbox.contained.launcher import user_tasks
-
-    def process(pid: str, uids: str, threads: int | None) -> None:
-        (tmp_path / pid).mkdir()
-        lines = ["Name:\tpython3", f"Uid:\t{uids}"] + \
-            ([f"Threads:\t{threads}"] if threads is not None else [])
-        (tmp_path / pid / "status").write_text("\n".join(lines) + "\n")
-
-    process("10", "1000\t1000\t1000\t1000", 3)
-    process("11", "1000\t0\t0\t0", 4)  # real uid 1000, set-uid root: counted
-    process("12", "0\t1000\t1000\t1000", 9)  # real uid root: not counted
-    process("13", "1000\t1000\t1000\t1000", None)  # a short status: skipped
-    (tmp_path / "14").mkdir()  # gone between listing and reading
-    (tmp_path / "self").mkdir()
-    assert user_tasks(1000, str(tmp_path)) == 7
-    # Live: this process's own threads are among its user's.
-    assert user_tasks(os.getuid()) >= len(os.listdir("/proc/self/task"))
-
-
 @pytest.mark.slow
 def test_a_grader_fault_is_exit_3_never_a_students_zero(tmp_path):
     """With the launcher unable to exec the interpreter, `grade` says the autograder

@@ -125,7 +125,7 @@ def test_a_student_who_joins_another_grading_fails_its_own(shout):
             result = grade(shout, CORPUS / "joins_other_domain")
         finally:
             _stop(victim)
-    assert result.isolation["mode"] == "user"
+    assert result.isolation.mode == "user"
     assert f"JOINED DOMAIN {other.domain}" in result.log
     assert result.grader_error is None, result.grader_details
     assert result.score < result.max_score

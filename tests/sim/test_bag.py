@@ -3,9 +3,7 @@ schemas, channels, counts per topic in simulation time, the transforms, metadata
 
 from __future__ import annotations
 
-import json
 import math
-import sys
 from collections import Counter
 from pathlib import Path
 from typing import Any
@@ -198,34 +196,6 @@ def test_a_new_recording_replaces_the_old_one_in_its_folder(tmp_path: Path) -> N
         recorder.close()
     _, messages, _ = _read(tmp_path / "again")
     assert [m.data for topic, _, m in messages if topic == "/chatter"] == ["second"]
-
-
-def test_the_embedded_tf_message_hash_is_the_one_rosidl_computes() -> None:
-    generator = pytest.importorskip("rosidl_generator_type_description")
-    share = Path(sys.prefix) / "share" / "geometry_msgs" / "msg" / "TransformStamped.json"
-    stamped = json.loads(share.read_text())["type_description_msg"]
-    types = {t["type_name"]: t for t in stamped["referenced_type_descriptions"]}
-    types[stamped["type_description"]["type_name"]] = stamped["type_description"]
-    unbounded_sequence_of_nested = 145
-    description = {
-        "type_description": {"type_name": msgdefs.TF_MESSAGE, "fields": [{
-            "name": "transforms", "default_value": "",
-            "type": {"type_id": unbounded_sequence_of_nested, "capacity": 0,
-                     "string_capacity": 0,
-                     "nested_type_name": "geometry_msgs/msg/TransformStamped"}}]},
-        "referenced_type_descriptions": [types[name] for name in sorted(types)]}
-    assert generator.calculate_type_hash(description) == msgdefs.type_hash(msgdefs.TF_MESSAGE)
-
-
-def test_type_names_and_full_text_follow_rosbag2() -> None:
-    assert msgdefs.type_name(Twist) == "geometry_msgs/msg/Twist"
-    assert msgdefs.type_name(type("Odd", (), {"__module__": "odd"})) == "odd/msg/Odd"
-    text = msgdefs.full_text("geometry_msgs/msg/Twist")
-    own, _, rest = text.partition("\n" + "=" * 80 + "\n")
-    assert "Vector3  linear" in own
-    assert rest.startswith("MSG: geometry_msgs/Vector3\n")
-    with pytest.raises(msgdefs.DefinitionNotFound):
-        msgdefs.full_text("no_such_pkg/msg/Nothing")
 
 
 def test_a_command_after_the_last_tick_still_ends_the_recording(

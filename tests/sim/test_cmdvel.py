@@ -132,7 +132,7 @@ def test_sim_run_warns_once_per_publisher(capsys: pytest.CaptureFixture[str]) ->
                       "geometry_msgs/msg/Twist")
     warned: set[object] = set()
     for _ in range(3):
-        sim.cli._warn_mismatches(_Bridge([teleop]), warned)
+        sim.cli.warn_mismatches(_Bridge([teleop]), warned)
     assert capsys.readouterr().err.count("node 'teleop' publishes") == 1
 
 

@@ -6,7 +6,6 @@ import numpy as np
 import pytest
 
 from sim.engine import Simulation
-from sim.faultkinds import KINDS, FaultKind, ScanDraft
 from sim.faults import FaultInjector, nan_readings, obstacle_at
 from sim.lidar import Lidar
 from sim.physics import World
@@ -103,22 +102,3 @@ def test_faults_from_the_world_file(tmp_path) -> None:
     due = [o for o in outs if o.scan_due]
     assert [o.scan is None for o in due] == [True, True, False, False, False]
     assert np.isnan(due[-1].scan.ranges).all()
-
-
-def test_a_new_kind_is_one_table_entry(tmp_path, monkeypatch: pytest.MonkeyPatch) -> None:
-    """Adding a kind to sim.faultkinds.KINDS is enough for world files and the injector."""
-
-    def zero(scan: ScanDraft, fault: Fault, pick) -> None:
-        scan.ranges[pick(fault.fraction)] = 0.0
-
-    monkeypatch.setitem(KINDS, "zero", FaultKind("a share of beams reads 0",
-                                                 ("start", "end", "fraction"), on_scan=zero))
-    path = tmp_path / "zero.yaml"
-    path.write_text("faults:\n  - {kind: zero, start: 0.5, fraction: 0.5}\n")
-    sim = Simulation(World(load_world(path)))
-    scans = [o.scan for o in (sim.step() for _ in range(200)) if o.scan is not None]
-    assert not (scans[0].ranges == 0).any()  # at 0.1 s: not yet
-    assert int((scans[-1].ranges == 0).sum()) == 180
-    FaultInjector().add(Fault(kind="zero"))  # run-time injection knows it too
-    with pytest.raises(ValueError, match="unknown fault kind"):
-        FaultInjector().add(Fault(kind="gremlins"))

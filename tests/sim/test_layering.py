@@ -58,21 +58,3 @@ def test_english_is_the_source_language(tmp_path: Path) -> None:
     empty.write_text("")
     with pytest.raises(ContentError, match="the file is empty"):
         load_world(empty)
-
-
-def test_sim_alone_honours_autograder_locales(tmp_path: Path,
-                                              monkeypatch: pytest.MonkeyPatch) -> None:
-    """Without the autograder, ``AUTOGRADER_LOCALES`` still says where the catalogs are."""
-    folder = tmp_path / "ur" / "LC_MESSAGES"
-    folder.mkdir(parents=True)
-    folder.joinpath("messages.po").write_text(
-        'msgid ""\nmsgstr "Content-Type: text/plain; charset=UTF-8\\n"\n\n'
-        'msgid "the file is empty"\nmsgstr "خالی"\n', encoding="utf-8")
-    monkeypatch.setenv("AUTOGRADER_LOCALES", str(tmp_path))
-    before = content.i18n.get_language()
-    content.i18n.set_language("ur")
-    try:
-        assert content.i18n._("the file is empty") == "خالی"
-        assert content.i18n._("the goal is outside the arena") == "the goal is outside the arena"
-    finally:
-        content.i18n.set_language(before)

@@ -183,4 +183,4 @@ def test_many_worlds_do_not_pile_up_prepared_geometry() -> None:
     for world in worlds:
         world.add_obstacle(Circle(center=(3.0, 4.0), radius=0.5))
         assert EXACT.scan(world)[90] == pytest.approx(0.5, abs=1e-9)
-    assert len(raycast._cache) <= 32
+    assert raycast.cached() <= raycast.CACHED_AT_MOST

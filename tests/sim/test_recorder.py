@@ -1,10 +1,9 @@
-"""Recording to JSON and the trajectory picture."""
+"""Recording to JSON, and what a replay needs. (The trajectory picture: tests/sim/test_svg.py.)"""
 
 from __future__ import annotations
 
 import json
 import math
-import xml.etree.ElementTree as ET
 from dataclasses import astuple
 
 import pytest
@@ -12,8 +11,7 @@ import pytest
 from sim.engine import Simulation
 from sim.physics import World
 from sim.recorder import MAX_TRAJECTORY_ROWS, SCAN_BUDGET, Recording
-from sim.svg import trajectory_svg
-from sim.worldfile import Goal, load_world
+from sim.worldfile import load_world
 
 
 def _run(world: str, steps: int = 800) -> Simulation:
@@ -38,25 +36,6 @@ def test_recording_samples_every_odom_and_collisions() -> None:
     assert again.collisions == sim.recording.collisions
     assert again.to_dict() == data
     assert 0.85 < sim.recording.distance() < 0.9
-
-
-def test_svg_shows_path_start_end_goal_and_collisions() -> None:
-    sim = _run("wall_ahead")
-    svg = trajectory_svg(sim.world.spec, sim.recording, goal=Goal(x=5.0, y=5.0))
-    root = ET.fromstring(svg)  # well-formed, self-contained
-    classes = {el.get("class") for el in root.iter()}
-    assert {"path", "start", "end", "goal", "collision", "wall"} <= classes
-    path = next(el for el in root.iter() if el.get("class") == "path")
-    points = path.get("points").split()
-    assert points[0] == "3,3" and points[-1] == "3.896,3" and len(points) == 201
-    assert "<script" not in svg and "href" not in svg
-
-
-def test_svg_of_obstacles_world_without_motion() -> None:
-    spec = load_world("obstacles")
-    svg = trajectory_svg(spec, Recording())
-    assert svg.count('class="box"') == 3 and svg.count('class="obstacle"') == 3
-    assert 'class="path"' not in svg
 
 
 # -- what a replay needs: commands and scans --------------------------------------------

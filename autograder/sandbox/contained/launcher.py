@@ -181,7 +181,7 @@ def hide_all_but(needed: list[str]) -> None:
     walk("/")
 
 
-def _barrier(path: str) -> str | None:
+def barrier_above(path: str) -> str | None:
     """The topmost folder above ``path`` that the student would not get through: ``/tmp``
     and ``/dev/shm`` (replaced by fresh ones), or one closed to other users (``/root``)."""
     parts = Path(path).parts
@@ -214,7 +214,7 @@ def fill_workdir(workdir: str, size_mb: int, uid: int, needed: list[str]) -> Non
     staged = {p.name: p.read_bytes() for p in Path(workdir).iterdir() if p.is_file()}
     barriers: dict[str, list[str]] = {folder: [] for folder in FRESH if os.path.isdir(folder)}
     for path in dict.fromkeys(os.path.realpath(p) for p in needed):
-        barrier = _barrier(path)
+        barrier = barrier_above(path)
         if barrier is not None:
             barriers.setdefault(barrier, []).append(path)
     # Reach each needed folder before anything covers it; bind it back afterwards.

@@ -16,7 +16,7 @@ grader each child's pid, and its wait status and peak resident size once it has 
 The zygote holds nothing of the grader's: it is started from a clean environment, never
 sees the course's tests, the report's key or the grader's files, and is single-threaded
 but for LTTng's listener threads (OpenBLAS is held to one thread, so numpy starts none),
-whose library is told of each fork as it asks (:func:`_fork_with_hooks`).  It
+whose library is told of each fork as it asks (:func:`fork_with_hooks`).  It
 ends when the grader's end of the socket closes, and with the grader's process
 (its socket's end closes however the grader ends).
 """
@@ -72,7 +72,7 @@ def serve(fd: int) -> tuple[str, list[str]]:
     contained, with the script to run and its arguments."""
     sock = socket.socket(fileno=fd)
     _warm()
-    fork = _fork_with_hooks()
+    fork = fork_with_hooks()
     wake_read, wake_write = os.pipe()
     os.set_blocking(wake_write, False)
     signal.set_wakeup_fd(wake_write)
@@ -94,7 +94,7 @@ def serve(fd: int) -> tuple[str, list[str]]:
                 signal.set_wakeup_fd(-1)
                 signal.signal(signal.SIGCHLD, signal.SIG_DFL)
                 sock.detach()  # its descriptor is closed below, with the wake pipe's
-                _close_all_but(keep)
+                close_all_but(keep)
 
             try:
                 pid = fork(in_child)
@@ -130,7 +130,7 @@ def _lttng_hooks() -> list[ForkHook]:
     return hooks
 
 
-def _fork_with_hooks(hooks: Sequence[ForkHook] | None = None,
+def fork_with_hooks(hooks: Sequence[ForkHook] | None = None,
                      ) -> Callable[[Callable[[], None]], int]:
     """``os.fork`` wrapped in LTTng's fork hooks, the protocol of LTTng's own
     ``liblttng-ust-fork``: without them a forked child dies of SIGSEGV at exit, when LTTng
@@ -159,7 +159,7 @@ def _fork_with_hooks(hooks: Sequence[ForkHook] | None = None,
     return fork
 
 
-def _close_all_but(keep: Sequence[int]) -> None:
+def close_all_but(keep: Sequence[int]) -> None:
     """Close every descriptor above stderr but those in ``keep``."""
     low = 3
     for fd in sorted(set(keep)):

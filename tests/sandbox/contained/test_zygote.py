@@ -12,6 +12,7 @@ import os
 import re
 import signal
 import time
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -24,6 +25,7 @@ from autograder.sandbox.process import (
     StudentProcess,
     close_zygotes,
     student_process,
+    zygotes,
 )
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -142,10 +144,17 @@ def test_a_failure_before_the_program_is_the_launchers_either_way(
         assert "never" not in program.output_text()
 
 
+@pytest.fixture
+def fresh_zygotes() -> Iterator[None]:
+    """No zygote from an earlier test, nor a failed start remembered, before or after."""
+    close_zygotes()
+    yield
+    close_zygotes()
+
+
+@pytest.mark.usefixtures("fresh_zygotes")
 def test_a_dead_zygote_leaves_its_programs_killed_and_later_ones_execd(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(process_module, "_zygotes", {})
-    monkeypatch.setattr(process_module, "_zygotes_failed", set())
     monkeypatch.setenv("AUTOGRADER_ZYGOTE", "1")
     staged = tmp_path / "staged"
     staged.mkdir()
@@ -160,7 +169,7 @@ def test_a_dead_zygote_leaves_its_programs_killed_and_later_ones_execd(
     first = start()
     try:
         assert isinstance(first.popen, ForkedProcess)
-        (zygote,) = process_module._zygotes.values()
+        (zygote,) = zygotes()
         os.kill(zygote.process.pid, signal.SIGKILL)
         zygote.process.wait()
         assert first.wait(0.5) is None  # still running, though its zygote is gone
@@ -175,12 +184,11 @@ def test_a_dead_zygote_leaves_its_programs_killed_and_later_ones_execd(
         first.stop()
 
 
+@pytest.mark.usefixtures("fresh_zygotes")
 def test_a_zygote_that_cannot_start_costs_only_its_own_launches(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """An interpreter that is not there (test_launch's case) fails its own zygote, and
     the launcher reports it; the next program, run by the real interpreter, is forked."""
-    monkeypatch.setattr(process_module, "_zygotes", {})
-    monkeypatch.setattr(process_module, "_zygotes_failed", set())
     monkeypatch.setenv("AUTOGRADER_ZYGOTE", "1")
     for name, python in (("missing", "/nonexistent/python3"), ("real", None)):
         if python is None:
@@ -212,7 +220,7 @@ def test_the_zygotes_descriptors_are_closed_before_lttngs_threads_start_again(
     sockets at once.  The zygote's descriptors are closed before that hook runs, so nothing
     the hook opens is closed behind its back (CI once saw a listener's close take the
     student's cgroup file: "the launcher failed at cgroup: Bad file descriptor")."""
-    from autograder.sandbox.contained.zygote import _close_all_but, _fork_with_hooks
+    from autograder.sandbox.contained.zygote import close_all_but, fork_with_hooks
 
     report_read, report_write = os.pipe()
     leftover = os.open(tmp_path, os.O_RDONLY)  # a descriptor of the zygote's own
@@ -224,8 +232,8 @@ def test_the_zygotes_descriptors_are_closed_before_lttngs_threads_start_again(
     def nothing(_saved: object) -> None:
         return None
 
-    fork = _fork_with_hooks([(nothing, nothing, child_hook, None)])
-    pid = fork(lambda: _close_all_but([report_write]))
+    fork = fork_with_hooks([(nothing, nothing, child_hook, None)])
+    pid = fork(lambda: close_all_but([report_write]))
     if pid == 0:
         def is_open(fd: int) -> bool:
             try:
