@@ -10,14 +10,20 @@ def test_a_busy_loop_is_blamed_even_on_a_loaded_machine():
     assert kept_busy((0, 0), (4 * S, 6 * S), 10.0)
 
 
+def test_a_busy_loop_given_a_small_share_of_a_crowded_machine_is_blamed():
+    # 12 s of wall time at load 12 on two cores: running 2 s, queued the other 10.
+    assert kept_busy((0, 0), (2 * S, 10 * S), 12.0)
+
+
 def test_an_idle_node_on_a_starved_machine_is_not_blamed():
     # It ran 0.3 s and waited 2 s: the rest of the 10 s it slept, waiting for ticks.
     assert not kept_busy((0, 0), (S * 3 // 10, 2 * S), 10.0)
 
 
 def test_a_node_kept_waiting_all_along_is_not_blamed():
-    # Four threads queued for a CPU for 9 s each: waits add up past the wall time.
-    assert not kept_busy((5 * S, 0), (5 * S + S // 2, 36 * S), 10.0)
+    # Four threads queued for a CPU for 9 s each, 0.3 s of CPU between them: waits add up
+    # past the wall time, and what ran is below BUSY_CPU_SECONDS.
+    assert not kept_busy((5 * S, 0), (5 * S + 3 * S // 10, 36 * S), 10.0)
 
 
 def test_nothing_watched_is_never_the_node():
