@@ -69,7 +69,7 @@ def main() -> None:
             if result.memory is not None:
                 memory.setdefault(exercise.id, []).append(result.memory)
             for module in result.pacing.values():
-                ticks.update({k: v for k, v in module.items() if k in ("idle", "budget", "cap")})
+                ticks.update({k: module.count(k) for k in ("idle", "budget", "cap")})
         startup = f"{statistics.median(startups):.2f} s" if startups else "-"
         cpu_medians[exercise.id] = statistics.median(cpus)
         floors[exercise.id] = _floor(timings[exercise.id], exercise.real_time_factor,

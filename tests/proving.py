@@ -325,7 +325,9 @@ def diagnosis(result: RunResult) -> dict[str, Any]:
             # What the lost tests measured (e.g. when each rate report came), so a verdict
             # that changed only now and then can be read from CI's log.
             **({"charts": charts} if charts else {}),
-            **{key: getattr(result, key) for key in ("pacing", "timing") if getattr(result, key)}}
+            **({"pacing": {m: p.to_dict() for m, p in result.pacing.items()}}
+               if result.pacing else {}),
+            **({"timing": result.timing.to_dict()} if result.timing is not None else {})}
 
 
 _BOTH_TYPES = (re.compile(r"geometry_msgs/msg/Twist\b"),

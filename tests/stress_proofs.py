@@ -107,7 +107,7 @@ def _paced(result: RunResult) -> str:
     return "; ".join(
         f"{module}: " + ", ".join(f"{key}={counts[key]}" for key in notable
                                   if counts.get(key))
-        for module, counts in sorted(result.pacing.items()))
+        for module, counts in sorted((m, p.to_dict()) for m, p in result.pacing.items()))
 
 
 def _round(chosen: list[tuple[str, Variant]], workdir: Path,

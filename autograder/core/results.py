@@ -214,6 +214,57 @@ class RunTiming:
 
 
 @dataclasses.dataclass(frozen=True)
+class ModulePacing:
+    """How one test module's world paced itself: how many holds of simulation time ended
+    each way (``outcomes``, by :data:`sim.pacing.HoldOutcome`: ``free``, ``idle``,
+    ``budget``, ``cap``, ...; only those that happened, in the order they first did), the
+    longest hold and all held, in wall seconds, and the bridge's counters (late deliveries
+    and commands, bursts, receipts awaited, the latest command's lateness in sim seconds).
+    A counter is None where the results did not carry it (an older file)."""
+
+    outcomes: Mapping[str, int] = dataclasses.field(default_factory=dict)
+    longest_hold: float | None = None
+    held_seconds: float | None = None
+    late_deliveries: int | None = None
+    bursts: int | None = None
+    receipts_awaited: int | None = None
+    late_commands: int | None = None
+    latest_command: float | None = None
+
+    def count(self, outcome: str) -> int:
+        return self.outcomes.get(outcome, 0)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {**self.outcomes, **{field.name: value for field in dataclasses.fields(self)[1:]
+                                    if (value := getattr(self, field.name)) is not None}}
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> ModulePacing:
+        counters = {field.name for field in dataclasses.fields(cls)[1:]}
+        return cls(outcomes={k: v for k, v in data.items() if k not in counters},
+                   **{k: v for k, v in data.items() if k in counters})
+
+
+@dataclasses.dataclass(frozen=True)
+class StartedProcess:
+    """A student program a grading started: its pid (also its process group), the cgroup
+    folders it ran in, the bounds that held it and the user it ran as (None: the grader's)."""
+
+    pid: int
+    cgroups: tuple[str, ...] = ()
+    bounds: ProcessBounds | None = None
+    uid: int | None = None
+
+    @classmethod
+    def from_record(cls, record: Mapping[str, Any]) -> StartedProcess:
+        """From the child's report (``GradingReporter.note_process``)."""
+        bounds = record.get("bounds")
+        return cls(pid=int(record["pid"]), cgroups=tuple(record.get("cgroups", ())),
+                   bounds=ProcessBounds.from_dict(bounds) if bounds else None,
+                   uid=record.get("uid"))
+
+
+@dataclasses.dataclass(frozen=True)
 class MemoryUse:
     """A grading's memory in MB: the children's peak resident sizes, summed (an upper bound,
     see :func:`autograder.grading.module_groups.merge`: ``grader_mb`` the child pytests,
@@ -284,7 +335,7 @@ class RunResult:
     isolation: Containment | None = None
     # How the world paced itself, per test module: the counters ``sim.bridge`` keeps and
     # ``autograder.plugin.world`` adds to, whose names are theirs (left open here).
-    pacing: Mapping[str, Mapping[str, Any]] = dataclasses.field(default_factory=dict)
+    pacing: Mapping[str, ModulePacing] = dataclasses.field(default_factory=dict)
     # ``--record DIR``: each test module's rosbag2 bag folder.
     bags: Mapping[str, str] = dataclasses.field(default_factory=dict)
     # What the student should know that is no test's verdict (a recording that failed).
@@ -297,7 +348,7 @@ class RunResult:
     # -- for the grader and the reports only --
     recordings: Mapping[str, Mapping[str, Any]] = dataclasses.field(default_factory=dict)
     domains: tuple[int, ...] = ()
-    processes: tuple[Mapping[str, Any], ...] = ()
+    processes: tuple[StartedProcess, ...] = ()
     student_uids: tuple[int, ...] | None = None
     strangers: tuple[int, ...] = ()  # other users' programs seen on the grading's domains
     startup_seconds: tuple[float, ...] = ()
@@ -368,7 +419,8 @@ class RunResult:
                    grader_error=data.get("grader_error"),
                    execution_time=data.get("execution_time", 0.0),
                    isolation=Containment.from_dict(isolation) if isolation else None,
-                   pacing=data.get("pacing", {}),
+                   pacing={module: ModulePacing.from_dict(counts)
+                           for module, counts in data.get("pacing", {}).items()},
                    bags=data.get("bags", {}), warnings=tuple(data.get("warnings", ())),
                    timing=RunTiming.from_dict(timing) if timing else None,
                    memory=MemoryUse.from_dict(memory) if memory else None,
@@ -392,7 +444,8 @@ class RunResult:
             "grader_error": self.grader_error,
             "execution_time": round(self.execution_time, 3),
             **({"isolation": self.isolation.to_dict()} if self.isolation is not None else {}),
-            **({"pacing": dict(self.pacing)} if self.pacing else {}),
+            **({"pacing": {module: pacing.to_dict() for module, pacing in self.pacing.items()}}
+               if self.pacing else {}),
             **({"bags": dict(self.bags)} if self.bags else {}),
             **({"warnings": list(self.warnings)} if self.warnings else {}),
             **({"disturbed": [list(uids) for uids in self.disturbed]}

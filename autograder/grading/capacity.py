@@ -234,7 +234,7 @@ def decide(tally: Tally, *, cores: float, memory_mb: float, students: int,
 def starved(result: RunResult) -> bool:
     """Whether a grading's results show a student's program starved of CPU: a world that
     went on at its wall cap while the program still had work (``pacing``)."""
-    return any(module.get("cap", 0) for module in result.pacing.values())
+    return any(module.count("cap") for module in result.pacing.values())
 
 
 class AutoChooser:

@@ -25,9 +25,11 @@ from autograder.core.report import RawReport, RawTest
 from autograder.core.results import (
     Containment,
     MemoryUse,
+    ModulePacing,
     NotRun,
     RunResult,
     RunTiming,
+    StartedProcess,
     TestResult,
     exact,
 )
@@ -132,9 +134,9 @@ def _grade_once(exercise: Exercise, submission: Path | None, *, hidden: bool,
         return _fault(exercise, str(exc), time.monotonic() - started)
     if warnings:
         result = dataclasses.replace(result, warnings=(*warnings, *result.warnings))
-    # Where each ran on this machine is the reaping's business, not the results'.
-    processes = [{k: v for k, v in p.items() if k != "workdir"} for p in raw.processes]
-    bounds = processes[0].get("bounds") if processes else None
+    # Where each ran on this machine (its folder) is the reaping's business, not the results'.
+    processes = [StartedProcess.from_record(p) for p in raw.processes]
+    bounds = raw.processes[0].get("bounds") if raw.processes else None
     # Each child's students run as the user of its domain.
     uids = [student_uid(lock.domain) for lock in locks] if isolation.own_user else None
     return dataclasses.replace(
@@ -395,7 +397,9 @@ def verdict(exercise: Exercise, raw_report: RawReport, ended: Sequence[children.
         execution_time=elapsed,
         recordings=data.get("recordings", {}), timed_out=any(e.timed_out for e in ended),
         startup_seconds=tuple(data.get("startup_seconds", ())),
-        pacing=data.get("pacing", {}), bags=data.get("bags", {}),
+        pacing={module: ModulePacing.from_dict(counts)
+                for module, counts in data.get("pacing", {}).items()},
+        bags=data.get("bags", {}),
         warnings=tuple(data.get("warnings", ())),
         strangers=tuple(sorted({uid for raw in raw_report.tests for uid in raw.strangers})),
         silent=bool(logs) and not any(v.strip() for v in logs.values()))

@@ -10,8 +10,8 @@ from autograder.core.results import RunResult
 def leftovers(result: RunResult) -> list[int]:
     """Live processes in the run's process groups or cgroups, or owned by its student user."""
     started = result.processes
-    groups = {p["pid"] for p in started}
-    cgroups = {Path(c).name for p in started for c in p.get("cgroups", [])}
+    groups = {p.pid for p in started}
+    cgroups = {Path(c).name for p in started for c in p.cgroups}
     uid = result.student_uid
     found = []
     for entry in Path("/proc").iterdir():

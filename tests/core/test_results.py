@@ -15,10 +15,12 @@ from pathlib import Path
 from autograder.core.results import (
     Containment,
     MemoryUse,
+    ModulePacing,
     NotRun,
     ProcessBounds,
     RunResult,
     RunTiming,
+    StartedProcess,
     TestResult,
     as_decimal,
     exact,
@@ -50,7 +52,8 @@ def full_run() -> RunResult:
                                          "bounds": {"cgroup": "v2", "processes": "cgroup",
                                                     "memory": "cgroup", "cpu": "cgroup"},
                                          "student_uids": [61007, 61008]}),
-        pacing={"test_shout.py": {"idle": 3, "budget": 5, "cap": 0, "longest_hold": 0.25}},
+        pacing={"test_shout.py": ModulePacing.from_dict(
+            {"idle": 3, "budget": 5, "cap": 0, "longest_hold": 0.25})},
         bags={"test_shout.py": "/r/test_shout"}, warnings=("disk full",),
         disturbed=((1001, 1002),),
         timing=RunTiming(child_start=1.234, tests=5.5, total=8.0,
@@ -174,3 +177,26 @@ def test_not_run_says_what_the_grade_adds() -> None:
         "The grade also runs hidden tests (2.5 points)."
     assert NotRun().describe() == "The grade also runs hidden tests."
     assert NotRun.from_dict(NotRun(3, Fraction(1, 2)).to_dict()) == NotRun(3, Fraction(1, 2))
+
+
+def test_a_modules_pacing_keeps_its_outcomes_apart_from_its_counters_and_their_order() -> None:
+    written = {"free": 20, "budget": 1, "idle": 50, "longest_hold": 0.14, "held_seconds": 0.222,
+               "late_deliveries": 1, "bursts": 0, "receipts_awaited": 0, "late_commands": 0,
+               "latest_command": 0.0}
+    pacing = ModulePacing.from_dict(written)
+    assert dict(pacing.outcomes) == {"free": 20, "budget": 1, "idle": 50}
+    assert pacing.count("budget") == 1 and pacing.count("cap") == 0
+    assert pacing.held_seconds == 0.222 and pacing.bursts == 0
+    assert json.dumps(pacing.to_dict()) == json.dumps(written)  # as the child wrote it
+    older = ModulePacing.from_dict({"idle": 3})  # a file without the counters
+    assert older.longest_hold is None and older.to_dict() == {"idle": 3}
+
+
+def test_a_started_process_is_read_from_the_childs_record_without_its_folder() -> None:
+    record = {"pid": 4242, "cgroups": ["/sys/fs/cgroup/ag/p1"], "workdir": "/tmp/ag-x",
+              "bounds": {"cgroup": "v2", "processes": "cgroup", "memory": "cgroup",
+                         "cpu": None}, "uid": 61007}
+    process = StartedProcess.from_record(record)
+    assert process == StartedProcess(4242, ("/sys/fs/cgroup/ag/p1",),
+                                     ProcessBounds("v2", "cgroup", "cgroup", None), 61007)
+    assert StartedProcess.from_record({"pid": 7}) == StartedProcess(7)

@@ -15,7 +15,7 @@ from click.testing import CliRunner
 
 from autograder.cli import main
 from autograder.commands.batch import run_batch
-from autograder.core.results import RunResult, TestResult
+from autograder.core.results import ModulePacing, RunResult, TestResult
 from autograder.grading import capacity
 from autograder.grading.capacity import (
     AutoChooser,
@@ -143,7 +143,8 @@ def test_a_starved_student_caps_the_concurrency_below_where_it_happened() -> Non
     ({"test_a": {"idle": 40}, "test_b": {"idle": 9, "cap": 1}}, True)],
     ids=["no-world", "held-within-budget", "cap-hit"])
 def test_starved_reads_the_pacing_cap(pacing, expected) -> None:
-    assert starved(dataclasses.replace(_result(3), pacing=pacing)) is expected
+    typed = {module: ModulePacing.from_dict(counts) for module, counts in pacing.items()}
+    assert starved(dataclasses.replace(_result(3), pacing=typed)) is expected
 
 
 def test_the_chooser_decides_again_and_says_so_only_when_the_number_changes() -> None:
@@ -151,7 +152,8 @@ def test_the_chooser_decides_again_and_says_so_only_when_the_number_changes() ->
     said: list[str] = []
     chooser = AutoChooser(said.append, cores=lambda: 2.0, memory_mb=lambda: 8000.0,
                           cpu=lambda: next(cpu))
-    plain, starving = _result(3), dataclasses.replace(_result(3), pacing={"m": {"cap": 2}})
+    plain, starving = _result(3), dataclasses.replace(
+        _result(3), pacing={"m": ModulePacing.from_dict({"cap": 2})})
     assert chooser(10.0, plain, 1, 10) == 5  # 0.8 of a core: 2 cores x 2.0 / 0.8
     assert chooser(20.0, plain, 5, 9) == 8  # a mean of 4.25 s over the first 10 s: 0.425
     assert chooser(25.0, plain, 8, 8) == 8  # 0.4: still the ceiling, nothing said

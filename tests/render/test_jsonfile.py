@@ -13,6 +13,7 @@ from graded_result import graded_result as result
 from autograder.core.results import (
     Containment,
     MemoryUse,
+    ModulePacing,
     ProcessBounds,
     RunResult,
     RunTiming,
@@ -58,7 +59,7 @@ def test_the_results_file_reads_back_with_its_timing_memory_and_pacing():
                                 modules={"test_a.py": {"total": 8.0}}, children=1),
             "memory": MemoryUse(grader_mb=90.0, student_mb=80.0, total_mb=170.0,
                                 footprint_mb=120.5),
-            "pacing": {"test_a.py": {"idle": 10, "late_deliveries": 1}},
+            "pacing": {"test_a.py": ModulePacing({"idle": 10}, late_deliveries=1)},
             "warnings": ("w",), "bags": {"test_a.py": "a.mcap"}}
     written = json.loads(to_json(dataclasses.replace(result(), **data)))
     assert written["isolation"]["student_uids"] == [61003]

@@ -7,12 +7,13 @@ import subprocess
 import sys
 import time
 
-from autograder.core.results import RunResult
+from autograder.core.results import RunResult, StartedProcess
 from autograder.sandbox.leftovers import leftovers
 
 
 def ran(*processes: dict) -> RunResult:
-    return RunResult("exercise", "x", "X", (), processes=processes)
+    return RunResult("exercise", "x", "X", (),
+                     processes=tuple(StartedProcess.from_record(p) for p in processes))
 
 
 def test_a_live_process_in_the_runs_group_is_left_over() -> None:
