@@ -153,7 +153,7 @@ def _launch(request: pytest.FixtureRequest, exercise: Exercise, script: Path, pr
     # An earlier instance may still be on the graph: its name until its participant's
     # lease runs out, some of its endpoints too. Only publishers that were not there
     # before the start are this instance's.
-    stale = _node_endpoints(probe, exercise.node) if wait_for_node else set()
+    stale = endpoints_of(probe, exercise.node) if wait_for_node else set()
     listeners = world.clock_listeners()  # /clock's subscriptions before this instance's
     reporter = request.config.stash.get(reporter_key, None)
     if reporter is not None:
@@ -167,14 +167,14 @@ def _launch(request: pytest.FixtureRequest, exercise: Exercise, script: Path, pr
     process.start()
     world.watch_pid(process.pid)
     node = StudentNode(process, exercise.node, probe, _log_keeper(request),
-                       _shown_folder(request.config.stash[settings_key].submission_name))
+                       shown_folder(request.config.stash[settings_key].submission_name))
     if wait_for_node:
         earlier = request.config.stash.get(startup_key, None)
         if earlier is not None:  # it already failed to appear once: do not wait again
             node.stop()
             raise StudentFailure(earlier.message, earlier.hint)
         try:
-            _wait_for_node(exercise, node, world, stale, listeners)
+            wait_for_node_up(exercise, node, world, stale, listeners)
         except NodeNeverAppeared as failure:  # stopped already
             request.config.stash[startup_key] = failure
             raise
@@ -188,7 +188,7 @@ def _launch(request: pytest.FixtureRequest, exercise: Exercise, script: Path, pr
 
 
 
-def _shown_folder(submission_name: str | None) -> str:
+def shown_folder(submission_name: str | None) -> str:
     """The prefix that stands for the program's folder in what it writes: the folder of
     the student's file as they named it, with its slash ("" for a bare file name)."""
     folder = os.path.dirname(submission_name or "")
@@ -207,12 +207,12 @@ class NodeNeverAppeared(StudentFailure):
     """The program ran, but its node never showed up on the graph (not a crash)."""
 
 
-def _node_endpoints(probe: Probe, name: str) -> set[bytes]:
+def endpoints_of(probe: Probe, name: str) -> set[bytes]:
     """The GIDs of the publishers node ``name`` has on the topics every node publishes."""
     return set(node_endpoints(probe.node, name))
 
 
-def _wait_for_node(exercise: Exercise, node: StudentNode, world: SimBridge,
+def wait_for_node_up(exercise: Exercise, node: StudentNode, world: SimBridge,
                    stale: set[bytes], listeners: int | None = None) -> None:
     """Wait, with simulation time held, until this instance's node is on the graph and the
     world's /clock reaches it (``listeners``: /clock's subscriptions before the start; None:

@@ -129,7 +129,7 @@ def test_a_tail_that_shows_rclpys_shutdown_race_explains_it():
     ("obstacle_avoider.py", 'File "obstacle_avoider.py", line 55, in on_scan'),
     (None, 'File "obstacle_avoider.py", line 55, in on_scan')], ids=["folder", "bare", "none"])
 def test_a_traceback_names_the_students_file_not_the_throwaway_copy(submitted, shown):
-    from autograder.plugin.student import _shown_folder
+    from autograder.plugin.student import shown_folder
 
     output = BoundedOutput(4096)
     output.feed(b'Traceback (most recent call last):\n'
@@ -137,7 +137,7 @@ def test_a_traceback_names_the_students_file_not_the_throwaway_copy(submitted, s
                 b'  File "/tmp/autograder-student-x1/helpers.py", line 3, in ahead\n'
                 b'ValueError: min() arg is an empty sequence\n')
     node = StudentNode(FakeProcess(output), "obstacle_avoider", probe=None,
-                       shown_folder=_shown_folder(submitted))
+                       shown_folder=shown_folder(submitted))
     assert shown in node.output() and shown in node.output_tail()
     assert "/tmp/autograder-student-x1" not in node.output()
     assert 'helpers.py", line 3' in node.output()  # a sibling module: the same folder

@@ -13,7 +13,7 @@ from types import SimpleNamespace
 
 from graph_fakes import Graph, Info, World
 
-from autograder.plugin.student import StudentNode, _node_endpoints, _wait_for_node
+from autograder.plugin.student import StudentNode, endpoints_of, wait_for_node_up
 
 NAME = "obstacle_avoider"
 
@@ -23,7 +23,7 @@ def start(graph: Graph, world: World, stale: set[bytes]) -> StudentNode:
     process = SimpleNamespace(running=lambda: True, started_at=0.0, returncode=None, pid=0)
     node = StudentNode(process, NAME, probe)
     exercise = SimpleNamespace(node=NAME, startup_timeout=20.0, file="obstacle_avoider.py")
-    _wait_for_node(exercise, node, world, stale)
+    wait_for_node_up(exercise, node, world, stale)
     return node
 
 
@@ -31,7 +31,7 @@ def test_a_restart_waits_for_the_new_instance_not_the_lingering_one():
     old, new = Info(NAME, b"old"), Info(NAME, b"new")
     graph = Graph([old], [new], delay=5)
     world = World(graph)
-    stale = _node_endpoints(SimpleNamespace(node=graph), NAME)
+    stale = endpoints_of(SimpleNamespace(node=graph), NAME)
     assert stale == {b"old"}
     start(graph, world, stale)
     assert len(world.held_while_waiting) == 6  # not before the new instance showed
@@ -43,7 +43,7 @@ def test_a_lingering_name_without_endpoints_is_not_the_new_instance():
     # and a wait that took the name found the node 2 ms after the start.
     graph = Graph([], [Info(NAME, b"new")], delay=3, lingering={NAME})
     world = World(graph)
-    stale = _node_endpoints(SimpleNamespace(node=graph), NAME)
+    stale = endpoints_of(SimpleNamespace(node=graph), NAME)
     assert stale == set() and NAME in graph.names()
     start(graph, world, stale)
     assert len(world.held_while_waiting) == 4  # the look that showed the new publishers
@@ -62,4 +62,4 @@ def test_a_first_start_is_done_when_its_publishers_appear():
 
 def test_other_nodes_publishers_are_not_the_students():
     graph = Graph([Info("sim_world", b"w"), Info(NAME, b"a"), Info("talker", b"t")])
-    assert _node_endpoints(SimpleNamespace(node=graph), NAME) == {b"a"}
+    assert endpoints_of(SimpleNamespace(node=graph), NAME) == {b"a"}

@@ -22,16 +22,9 @@ REPO = Path(__file__).resolve().parents[2]
 TESTS = REPO / "tests"
 ROOTS = ("autograder", "sim", "content")
 
-# (test file, module.name) pairs still allowed. Each waits on its module's owner: a private
-# name of ``sim`` or of ``autograder/plugin`` is renamed there, not from here. Remove a line
-# once its test goes through public code; never add one.
-ALLOWED: frozenset[tuple[str, str]] = frozenset({
-    # plugin/student: the folder a traceback names (the fixture computes it from settings).
-    ("tests/core/test_output_budget.py", "autograder.plugin.student._shown_folder"),
-    # plugin/student: the node's endpoints and the wait for it on the graph (fixture-only).
-    ("tests/plugin/test_student.py", "autograder.plugin.student._node_endpoints"),
-    ("tests/plugin/test_student.py", "autograder.plugin.student._wait_for_node"),
-})
+# (test file, module.name) pairs still allowed: none. Never add one; make the name public
+# where it is a unit with a contract, or test it through the function that uses it.
+ALLOWED: frozenset[tuple[str, str]] = frozenset()
 
 
 def _ours(module: str | None) -> bool:
