@@ -308,6 +308,12 @@ class SimBridge:
         i = bisect.bisect_right(log, wall_ns, key=lambda entry: entry[0]) - 1
         return log[i][1] if i >= 0 else 0.0
 
+    @property
+    def last_tick_sent_ns(self) -> int | None:
+        """System time (ns) the last /clock went out at; None before the first."""
+        log = self._clock_log
+        return log[-1][0] if log else None
+
     def cmd_vel_mismatches(self) -> list[Mismatch]:
         """Publishers on /cmd_vel whose type is not the one this robot takes."""
         return mismatches(self.node, {CMD_VEL_TOPIC: full_name(self.cmd_vel_type)},
@@ -371,7 +377,7 @@ class SimBridge:
         sub, count = self._cmd_sub, 0
         with self._cond, sub.handle:
             while (taken := sub.handle.take_message(sub.msg_type, sub.raw)) is not None:
-                self._note_lateness(taken[1])
+                self.note_lateness(taken[1])
                 self._on_cmd_vel(taken[0])
                 count += 1
         return count
@@ -390,7 +396,7 @@ class SimBridge:
                                                twist.angular.z)
                 self._tap("/cmd_vel", taken[0], self.world.time)
 
-    def _note_lateness(self, info: object) -> None:
+    def note_lateness(self, info: object) -> None:
         """Count a command sent before the tick now due: ticks went on without it.  When it
         was sent is its DDS source timestamp, read as the sim time of the last /clock out
         by then (the clock is the machine's, the sender's and ours)."""

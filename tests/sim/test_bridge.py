@@ -171,9 +171,9 @@ def test_the_world_takes_commands_at_each_tick(graph: tuple[SimBridge, Probe]) -
         assert bridge.late_commands == 0  # sent while paused, taken before the next tick
         # One sent after the last tick went out, and taken only after the next, was late
         # by that tick.
-        sent = bridge._clock_log[-1][0] + 1
+        sent = (bridge.last_tick_sent_ns or 0) + 1
         bridge.step(1)
-        bridge._note_lateness({"source_timestamp": sent})
+        bridge.note_lateness({"source_timestamp": sent})
         assert bridge.late_commands == 1
         assert bridge.latest_command == pytest.approx(0.005)  # one tick of one 5 ms step
     finally:
