@@ -119,10 +119,12 @@ def _wall_corners(a: tuple[float, float], b: tuple[float, float],
 class World:
     """The pymunk world of one :class:`WorldSpec`, stepped at a fixed ``dt``."""
 
-    def __init__(self, spec: WorldSpec, seed: int | None = None, dt: float = 0.005) -> None:
+    def __init__(self, spec: WorldSpec, seed: int | None = None, dt: float = 0.005,
+                 direct_step: bool = True) -> None:
         self.spec = spec
         self.seed = spec.seed if seed is None else seed
         self.dt = dt
+        self.direct_step = direct_step
         self.reset()
 
     # -- building -----------------------------------------------------------------
@@ -149,10 +151,16 @@ class World:
         self._build_robot()
         self.space.on_collision(_ROBOT, _STATIC, begin=self._on_begin)
         self._c_space = self._c_robot = self._c_control = None
-        if (_chipmunk is not None and not self.space.threaded
+        if (self.direct_step and _chipmunk is not None and not self.space.threaded
                 and all(hasattr(self.space, name) for name in _SPACE_PENDING)):
             self._c_space = self.space._space
             self._c_robot, self._c_control = self.robot._body, self.control._body
+
+    @property
+    def steps_directly(self) -> bool:
+        """Whether a step calls Chipmunk itself (without ``Space.step``'s Python) when
+        nothing is pending; ``direct_step=False`` always takes pymunk's public path."""
+        return self._c_space is not None
 
     def _build_robot(self) -> None:
         start = self.spec.start

@@ -7,7 +7,7 @@ Counted, in every test file but the submissions' (which are students' code): an 
 a leading-underscore name from ``autograder``, ``sim`` or ``content``; such a name read off
 a module of theirs (``module._name``, ``monkeypatch.setattr(module, "_name", ...)``); and
 such an import in the text of code a test runs in a subprocess. Not counted: ``_`` (gettext),
-dunders, and an object's own attributes (``world._c_space``), which this check cannot
+dunders, and an object's own attributes (``bridge._cond``), which this check cannot
 tell from a local's.
 """
 
