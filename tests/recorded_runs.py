@@ -13,6 +13,15 @@ from sim.physics import World
 from sim.worldfile import Fault, load_world
 
 
+def driven(world: str, steps: int = 800) -> Simulation:
+    """The world after ``steps`` physics steps at 0.5 m/s straight ahead."""
+    sim = Simulation(World(load_world(world)))
+    sim.world.set_command(0.5, 0.0)
+    for _ in range(steps):
+        sim.step()
+    return sim
+
+
 def recorded(world: str, seconds: float, linear: float = 0.4, turn: float = 0.8,
              faults: tuple[Fault, ...] = ()) -> dict:
     """A run of the simulated world, driven as a node would (a command every 0.1 s)."""

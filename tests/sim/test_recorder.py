@@ -7,6 +7,7 @@ import math
 from dataclasses import astuple
 
 import pytest
+from recorded_runs import driven
 
 from sim.engine import Simulation
 from sim.physics import World
@@ -14,16 +15,8 @@ from sim.recorder import MAX_TRAJECTORY_ROWS, SCAN_BUDGET, Recording
 from sim.worldfile import load_world
 
 
-def _run(world: str, steps: int = 800) -> Simulation:
-    sim = Simulation(World(load_world(world)))
-    sim.world.set_command(0.5, 0.0)
-    for _ in range(steps):
-        sim.step()
-    return sim
-
-
 def test_recording_samples_every_odom_and_collisions() -> None:
-    sim = _run("wall_ahead")
+    sim = driven("wall_ahead")
     data = json.loads(json.dumps(sim.recording.to_dict()))
     assert len(data["trajectory"]) == 800 // 4  # 50 Hz at dt 0.005
     assert data["trajectory"][0][0] == 0.02

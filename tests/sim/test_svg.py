@@ -9,10 +9,9 @@ import xml.etree.ElementTree as ET
 from collections.abc import Iterator
 
 import pytest
+from recorded_runs import driven
 
 from autograder.i18n import set_language
-from sim.engine import Simulation
-from sim.physics import World
 from sim.recorder import Contact, Recording, Sample
 from sim.svg import scene_svg, trajectory_svg
 from sim.worldfile import Goal, load_world
@@ -26,16 +25,8 @@ def _english() -> Iterator[None]:
     yield
 
 
-def _run(world: str, steps: int = 800) -> Simulation:
-    sim = Simulation(World(load_world(world)))
-    sim.world.set_command(0.5, 0.0)
-    for _ in range(steps):
-        sim.step()
-    return sim
-
-
 def test_svg_shows_path_start_end_goal_and_collisions() -> None:
-    sim = _run("wall_ahead")
+    sim = driven("wall_ahead")
     svg = trajectory_svg(sim.world.spec, sim.recording, goal=Goal(x=5.0, y=5.0))
     root = ET.fromstring(svg)  # well-formed, self-contained
     classes = {el.get("class") for el in root.iter()}
