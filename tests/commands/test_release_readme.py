@@ -2,9 +2,10 @@
 release, run as pasted from a fresh copy of it, and none needs a solution or a key
 (issue 35). The release offers the quizzes as the pages in quizzes-rendered/.
 
-`python3 tasks.py setup`, the set-up, is not run: it would reinstall the venv these tests
-run in. That the release's tasks.py has the job, and that it installs no test tools, is
-checked here and in tests/project/test_tasks.py."""
+`python3 tasks.py setup`, the set-up, is not run here: it would reinstall the venv these
+tests run in. CI's `.ci/deployments` runs it, with the exercise block, from a fresh release
+in an ordinary user's home (`test_ci_runs_the_release_setup_as_pasted` holds it to that);
+that the release's tasks.py installs no test tools is checked in tests/project/test_tasks.py."""
 
 from __future__ import annotations
 
@@ -74,3 +75,15 @@ def test_the_urdu_readme_follows_the_glossary(release: Path) -> None:
 
     glossary = load_glossary(release / "locales" / "ur" / "glossary.yaml")
     assert [str(p) for p in glossary.check_readme(release / "README.ur.md")] == []
+
+
+def test_ci_runs_the_release_setup_as_pasted() -> None:
+    """`.ci/deployments` builds a release, and pastes its README's first two blocks (the
+    set-up and the exercise) as an ordinary user, not a copy of them of its own."""
+    script = (Path(__file__).resolve().parents[2] / ".ci" / "deployments").read_text()
+    body = script.split("release_check() {", 1)[1].split("\n}\n", 1)[0]
+    assert "autograder\" release" in body
+    assert '"$dir/README.md"' in body and "[:2]" in body
+    assert "runuser -u agstudent1" in body
+    assert "release_check || failures" in script
+    assert not [line for line in body.splitlines() if SETUP in line]
