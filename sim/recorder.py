@@ -165,8 +165,8 @@ class Recording:
                    samples=[Sample(*row) for row in data.get("trajectory", [])],
                    collisions=[Contact(**c) for c in data.get("collisions", [])],
                    commands=[Command(*row) for row in data.get("commands", [])],
-                   scans=[ScanRecord(t, array.array("f", (math.inf if r is None else r
-                                                          for r in ranges)))
+                   scans=[ScanRecord(t, array.array("f", [math.inf if r is None else r
+                                                          for r in ranges]))
                           for t, ranges in data.get("scans", [])],
                    scan_angle_min=scan.get("angle_min", 0.0),
                    scan_angle_increment=scan.get("angle_increment", 2 * math.pi / 360))
