@@ -11,12 +11,12 @@ the same trajectory bit for bit.  Nothing here knows about ROS.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 import pymunk
 
 from content.i18n import N_, NP_, _, pgettext
+from sim.contact import Contact
 from sim.worldfile import ROBOT_RADIUS, Box, Circle, WorldSpec
 
 ROBOT_MASS = 1.0
@@ -67,27 +67,6 @@ def describe(what: str, oblique: bool = False) -> str:
         return what  # "?" or a label a test chose
     text = pgettext(_OBLIQUE, template) if oblique else _(template)
     return text.format(number=number)
-
-
-@dataclass(frozen=True)
-class Contact:
-    """The robot started touching something: when, where the robot was, what it hit."""
-
-    t: float
-    x: float
-    y: float
-    what: str
-
-    @property
-    def description(self) -> str:
-        """What it hit, for people, in the active language ("wall 3" in English)."""
-        return describe(self.what)
-
-    @property
-    def hit_name(self) -> str:
-        """What it hit, as a sentence that says so names it: before a postposition, in the
-        oblique case ("the robot hit {what}": Urdu "ڈبے 2 سے ٹکرایا")."""
-        return describe(self.what, oblique=True)
 
 
 def _approach(current: float, target: float, max_delta: float) -> float:

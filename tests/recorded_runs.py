@@ -10,6 +10,7 @@ from fractions import Fraction
 from autograder.core.results import TestResult
 from sim.engine import Simulation
 from sim.physics import World
+from sim.recorder import Recording
 from sim.worldfile import Fault, load_world
 
 
@@ -23,8 +24,9 @@ def driven(world: str, steps: int = 800) -> Simulation:
 
 
 def recorded(world: str, seconds: float, linear: float = 0.4, turn: float = 0.8,
-             faults: tuple[Fault, ...] = ()) -> dict:
-    """A run of the simulated world, driven as a node would (a command every 0.1 s)."""
+             faults: tuple[Fault, ...] = ()) -> Recording:
+    """A run of the simulated world, driven as a node would (a command every 0.1 s), as
+    the grader reads it back from its child's report (through JSON)."""
     sim = Simulation(World(load_world(world)))
     for fault in faults:
         sim.inject(fault)
@@ -32,7 +34,7 @@ def recorded(world: str, seconds: float, linear: float = 0.4, turn: float = 0.8,
         if i % 20 == 0:
             sim.set_command(linear, turn * math.sin(i / 300))
         sim.step()
-    return json.loads(json.dumps(sim.recording.to_dict()))
+    return Recording.from_dict(json.loads(json.dumps(sim.recording.to_dict())))
 
 
 def a_test(module: str, name: str, label: str) -> TestResult:

@@ -85,7 +85,7 @@ class NodeRun:
         args = ["-p", "use_sim_time:=true"]
         for param in self.params:
             args += ["-p", param]
-        self.process = student_process(staged, args, self._limits(),
+        self.process = student_process(staged, args, self.limits,
                                        domain=bridge.node.context.get_domain_id(),
                                        strict=False, course=course)
         self.process.echo = self.echo
@@ -104,16 +104,22 @@ class NodeRun:
             click.echo(_("Node {names} is up; simulation time starts now.").format(
                 names=", ".join(sorted(set(found.values())))))
             return
-        raise self._not_up(timeout)
+        raise self.not_up(timeout)
 
-    def _limits(self) -> Limits:
+    @property
+    def limits(self) -> Limits:
+        """The exercise's limits (the defaults for a plain file) but no wall or CPU time
+        limit: a hand run ends when the student says so."""
         from autograder.core.exercise import Limits
 
         limits = self.exercise.limits if self.exercise is not None else Limits()
         return dataclasses.replace(limits, wall_seconds=HAND_RUN_SECONDS,
                                    cpu_seconds=HAND_RUN_SECONDS)
 
-    def _not_up(self, timeout: float) -> NodeNotUp:
+    def not_up(self, timeout: float) -> NodeNotUp:
+        """Why the node is not up after ``timeout`` seconds, for the student: their program
+        ended (and how), or it runs but no node of the exercise's name (any, for a plain
+        file) appeared."""
         assert self.process is not None
         if not self.process.running():
             code = self.process.returncode

@@ -14,6 +14,7 @@ from typing import Any, Literal
 
 from autograder.core.untrusted import visible
 from autograder.i18n import _, ngettext
+from sim.recorder import Recording
 
 Status = Literal["passed", "failed", "error", "skipped"]
 Visibility = Literal["visible", "hidden", "after_published"]
@@ -346,7 +347,8 @@ class RunResult:
     # The other users whose programs disturbed each grading done again before this one.
     disturbed: tuple[tuple[int, ...], ...] = ()
     # -- for the grader and the reports only --
-    recordings: Mapping[str, Mapping[str, Any]] = dataclasses.field(default_factory=dict)
+    # Each test module's run in the world, by module file name (``TestResult.module``).
+    recordings: Mapping[str, Recording] = dataclasses.field(default_factory=dict)
     domains: tuple[int, ...] = ()
     processes: tuple[StartedProcess, ...] = ()
     student_uids: tuple[int, ...] | None = None

@@ -15,7 +15,7 @@ import dataclasses
 import os
 import tempfile
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from fractions import Fraction
 from pathlib import Path
 from typing import Any
@@ -55,6 +55,7 @@ from autograder.sandbox.isolation import (
     run_prefix,
     student_uid,
 )
+from sim.recorder import Recording
 
 GRADER_FAULT = "the autograder failed, tell your instructor"
 # A grading that other users' programs disturbed is done again once they are gone, at
@@ -394,8 +395,8 @@ def verdict(exercise: Exercise, raw_report: RawReport, ended: Sequence[children.
         grader_details=details,
         log_tail="\n".join(v for v in logs.values() if v.strip())[-4000:],
         log=raw_report.output_log, not_run=not_run,
-        execution_time=elapsed,
-        recordings=data.get("recordings", {}), timed_out=any(e.timed_out for e in ended),
+        execution_time=elapsed, recordings=_recordings(data.get("recordings", {})),
+        timed_out=any(e.timed_out for e in ended),
         startup_seconds=tuple(data.get("startup_seconds", ())),
         pacing={module: ModulePacing.from_dict(counts)
                 for module, counts in data.get("pacing", {}).items()},
@@ -403,6 +404,19 @@ def verdict(exercise: Exercise, raw_report: RawReport, ended: Sequence[children.
         warnings=tuple(data.get("warnings", ())),
         strangers=tuple(sorted({uid for raw in raw_report.tests for uid in raw.strangers})),
         silent=bool(logs) and not any(v.strip() for v in logs.values()))
+
+
+def _recordings(recorded: Mapping[str, Any]) -> dict[str, Recording]:
+    """Each test module's recording, read back from what its child wrote
+    (:meth:`~sim.recorder.Recording.to_dict`). One that cannot be read is left out, as
+    before: the report then draws that run not at all, and the grade does not change."""
+    recordings = {}
+    for module, data in recorded.items():
+        try:
+            recordings[module] = Recording.from_dict(data)
+        except (AttributeError, KeyError, TypeError, ValueError):  # not a recording's shape
+            continue
+    return recordings
 
 
 def _not_run(exercise: Exercise, counted: dict[str, Any] | None,

@@ -87,7 +87,6 @@ def script() -> tuple[Markup, str]:
 
 def figures(result: RunResult, exercise_folder: Path | None) -> list[Figure]:
     """One figure per world the robot moved in, in the order the worlds were first used."""
-    from sim.recorder import Recording
     from sim.svg import scene_svg
     from sim.worldfile import ROBOT_RADIUS, load_world, title_of
 
@@ -96,15 +95,11 @@ def figures(result: RunResult, exercise_folder: Path | None) -> list[Figure]:
         module = test.module
         if module:
             labels.setdefault(module, []).append(Text(test.label, result.lang))
-    worlds: dict[str, list[tuple[str, Recording, dict[str, Any]]]] = {}
-    for module, recorded in result.recordings.items():
-        try:
-            recording = Recording.from_dict(recorded)
-        except Exception:  # a run we cannot read is left out
-            continue
+    worlds: dict[str, list[tuple[str, Recording]]] = {}
+    for module, recording in result.recordings.items():
         if not recording.samples or recording.distance() < 0.05:
             continue  # the robot stood still: nothing to look at
-        worlds.setdefault(recording.world, []).append((module, recording, recorded))
+        worlds.setdefault(recording.world, []).append((module, recording))
     found = []
     for name, runs in worlds.items():
         local = exercise_folder / f"{name}.yaml" if exercise_folder else None
@@ -114,29 +109,27 @@ def figures(result: RunResult, exercise_folder: Path | None) -> list[Figure]:
             continue
         title = title_of(spec)  # in English when not translated: marked so
         english = result.lang != "en" and title in (spec.title, spec.name)
-        replayable = any("scans" in recorded or "commands" in recorded
-                         for _m, _r, recorded in runs)
+        replayable = any(recording.scans or recording.commands for _m, recording in runs)
         overlay = _OVERLAY.format(radius=ROBOT_RADIUS) if replayable else ""
-        svg = scene_svg(spec, [recording for _m, recording, _d in runs], spec.goal, overlay)
+        svg = scene_svg(spec, [recording for _m, recording in runs], spec.goal, overlay)
         found.append(Figure(
             world=Text(title, "en" if english else result.lang, english),
             svg=Markup(svg),
             runs=tuple(Run(module, tuple(labels.get(module, [])), len(recording.collisions),
-                           _replay_data(spec, recording, recorded) if replayable else None)
-                       for module, recording, recorded in runs)))
+                           _replay_data(spec, recording) if replayable else None)
+                       for module, recording in runs)))
     return found
 
 
-def _replay_data(spec: WorldSpec, recording: Recording,
-                 recorded: dict[str, Any]) -> dict[str, Any]:
+def _replay_data(spec: WorldSpec, recording: Recording) -> dict[str, Any]:
     """What the script needs of one run, in the units of the recording (no English text:
     a collision is its time; what it hit is in the drawing's tooltips).  A run starts at
     sim time 0 at the world's start pose (the first odometry sample comes 0.02 s later)."""
+    recorded = recording.to_dict()  # the results' precision and bounds
     start = spec.start
     poses = [[0.0, start.x, start.y, start.theta]]
-    poses += [row[:4] for row in recorded.get("trajectory", []) if row[0] > 0]
-    commands = recorded.get("commands", [])
-    scans = recorded.get("scans", [])
+    poses += [row[:4] for row in recorded["trajectory"] if row[0] > 0]
+    commands, scans = recorded["commands"], recorded["scans"]
     end = max([poses[-1][0]] + [row[0] for row in commands[-1:]]
               + [row[0] for row in scans[-1:]])
     # How far apart the kept scans are: a scan older than 1.5 times that is not drawn, so
@@ -144,6 +137,5 @@ def _replay_data(spec: WorldSpec, recording: Recording,
     every = (scans[-1][0] - scans[0][0]) / (len(scans) - 1) if len(scans) > 1 else 0.5
     return {"end": end, "poses": poses, "scan_every": max(every, 0.5),
             "commands": commands, "scans": scans,
-            "scan": recorded.get("scan", {"angle_min": recording.scan_angle_min,
-                                          "angle_increment": recording.scan_angle_increment}),
+            "scan": recorded["scan"],
             "collisions": [c.t for c in recording.collisions]}

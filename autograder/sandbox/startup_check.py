@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import shutil
 import sys
+from collections.abc import Sequence
 from pathlib import Path
 
 from autograder.sandbox.isolation import Mode, bring_up_loopback, student_uid
@@ -62,7 +63,6 @@ def check_launch(mode: Mode = "strict") -> str | None:
                 f"{process.output_tail(3) or '(no output)'}")
 
 
-
 def _stop_as_ctrl_c() -> None:
     """SIGTERM, SIGHUP, and the grader's death (``PR_SET_PDEATHSIG``) end the check as
     Ctrl-C would: its ``finally`` stops the test program and removes its folders."""
@@ -77,9 +77,19 @@ def _stop_as_ctrl_c() -> None:
     ctypes.CDLL(None).prctl(1, signal.SIGTERM, 0, 0, 0)  # PR_SET_PDEATHSIG
 
 
-if __name__ == "__main__":
+def main(argv: Sequence[str] | None = None) -> int:
+    """The check as its process runs it (``argv``, else the command line's: the isolation
+    mode, else strict): 0 if the test program ran as its own user, else 1 with what went
+    wrong printed; stopped by a signal or the grader's death, it raises KeyboardInterrupt
+    with nothing left behind."""
     _stop_as_ctrl_c()
-    problem = check_launch(*sys.argv[1:2])  # type: ignore[arg-type]
-    if problem is not None:
-        print(problem)
-        sys.exit(1)
+    args = sys.argv[1:] if argv is None else argv
+    problem = check_launch(*args[:1])  # type: ignore[arg-type]
+    if problem is None:
+        return 0
+    print(problem)
+    return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

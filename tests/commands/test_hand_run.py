@@ -71,13 +71,13 @@ def test_no_time_limit_but_the_exercises_other_limits(tmp_path: Path) -> None:
     run = NodeRun(tmp_path / "node.py", found)
     assert run.node_name == found.node
     assert run.pacing_options() == {"cpu_budget": found.cpu_budget}
-    limits = run._limits()
+    limits = run.limits
     assert (limits.wall_seconds, limits.cpu_seconds) == (HAND_RUN_SECONDS, HAND_RUN_SECONDS)
     assert dataclasses.replace(limits, wall_seconds=found.limits.wall_seconds,
                                cpu_seconds=found.limits.cpu_seconds) == found.limits
     plain = NodeRun(tmp_path / "node.py")
     assert plain.node_name is None and plain.pacing_options() == {}
-    assert plain._limits().memory_mb == Limits().memory_mb
+    assert plain.limits.memory_mb == Limits().memory_mb
 
 
 @dataclasses.dataclass
@@ -92,17 +92,17 @@ class _Program:
 def test_why_a_node_did_not_come_up(tmp_path: Path) -> None:
     found = find_exercise("timer_sync")
     run = NodeRun(tmp_path / "node.py", found, process=_Program(False, 1))
-    assert str(run._not_up(20)) == ("Your program exited with status 1 during start-up, "
+    assert str(run.not_up(20)) == ("Your program exited with status 1 during start-up, "
                                     "before its node was up; its output is above.")
     run.process = _Program(False, -9)
-    assert "was killed by signal SIGKILL during start-up" in str(run._not_up(20))
+    assert "was killed by signal SIGKILL during start-up" in str(run.not_up(20))
     run.process = _Program(True)
-    assert str(run._not_up(20)).splitlines() == [
+    assert str(run.not_up(20)).splitlines() == [
         f"No node named '{found.node}' appeared on the ROS graph within 20 s.",
         f"Create the node with `super().__init__('{found.node}')` and spin it."]
     plain = NodeRun(tmp_path / "node.py", process=_Program(True))
-    assert str(plain._not_up(7.6)) == "No node appeared on the ROS graph within 8 s."
-    assert isinstance(plain._not_up(1), NodeNotUp)
+    assert str(plain.not_up(7.6)) == "No node appeared on the ROS graph within 8 s."
+    assert isinstance(plain.not_up(1), NodeNotUp)
 
 
 def test_what_grading_refuses_is_refused_before_the_world(tmp_path: Path) -> None:

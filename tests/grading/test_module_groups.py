@@ -16,6 +16,8 @@ from autograder.core.results import RunResult
 from autograder.grading.children import Child, Ended
 from autograder.grading.module_groups import children_for, find_modules, merge, share_out
 from autograder.grading.run import GRADER_FAULT, verdict
+from sim.contact import Contact
+from sim.recorder import Recording, Sample
 
 PUBLIC, HIDDEN_A, HIDDEN_B = "tests/public/test_p.py", "tests/hidden/test_a.py", \
     "tests/hidden/test_b.py"
@@ -213,6 +215,18 @@ def test_a_child_that_broke_is_the_graders_fault_with_its_own_log() -> None:
     assert "ImportError in test_a.py" in result.grader_details
     assert "fine" not in result.grader_details
     assert [t.name for t in result.tests] == ["p"]  # the others' results still count
+
+
+def test_each_modules_recording_is_read_back_and_one_unreadable_left_out() -> None:
+    recorded = Recording(world="obstacles", samples=[Sample(0.02, 3.0, 3.0, 0.0, 0.1, 0.0)],
+                         collisions=[Contact(0.02, 3.0, 3.0, "box 0")])
+    ended = _ended(_test(PUBLIC, "p"), returncode=0)
+    raw = dataclasses.replace(ended.raw, data={"recordings": {
+        "test_p.py": recorded.to_dict(), "test_a.py": {"trajectory": [[0.1, 3.0]]}}})
+    result = verdict(load_exercise(SHOUT), raw, [ended], 1.0)
+    assert list(result.recordings) == ["test_p.py"]
+    assert result.recordings["test_p.py"] == recorded
+    assert [(t.name, t.status) for t in result.tests] == [("p", "passed")]  # graded as ever
 
 
 @pytest.mark.parametrize(("options", "expected"), [

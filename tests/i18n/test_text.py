@@ -217,8 +217,8 @@ def test_urdu_report_has_no_english_collisions_or_world_names(urdu_catalog: Path
             Contact(2.9, 5.9, 3.0, "wall 3"), Contact(3.0, 1.2, 2.6, "circle 2")]
     run = _urdu_run()
     recordings = {
-        "test_a.py": Recording("obstacles", samples, hits).to_dict(),
-        "test_b.py": Recording("empty_room", samples, []).to_dict(),
+        "test_a.py": Recording("obstacles", samples, hits),
+        "test_b.py": Recording("empty_room", samples, []),
     }
     page = to_html(RunResult(run.kind, run.id, run.title, run.tests, lang="ur",
                              recordings=recordings))

@@ -36,7 +36,7 @@ def urdu_result() -> RunResult:
     )
     return RunResult("exercise", "timer_sync", "Timer synchronization: ایک multi-rate controller",
                      tests, lang="ur", log_tail="[INFO] [multi_rate_controller]: started",
-                     recordings={"test_world.py": recording.to_dict()})
+                     recordings={"test_world.py": recording})
 
 
 _LAYOUT_JS = """
@@ -105,7 +105,7 @@ def test_urdu_report_captions_read_right_to_left(tmp_path: Path) -> None:
     (tmp_path / "practice_yard.yaml").write_text(
         "title: Practice yard, 6 x 6 m\nsize: [6.0, 6.0]\n", encoding="utf-8")
     result = urdu_result()
-    recorded = {**result.recordings["test_world.py"], "world": "practice_yard"}
+    recorded = dataclasses.replace(result.recordings["test_world.py"], world="practice_yard")
     result = dataclasses.replace(result, recordings={"test_world.py": recorded})
     page_file = tmp_path / "report.ur.html"
     page_file.write_text(to_html(result, tmp_path), encoding="utf-8")

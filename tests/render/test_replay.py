@@ -16,6 +16,7 @@ from recorded_runs import a_test, recorded
 from autograder.core.results import RunResult
 from autograder.render.html import to_html
 from autograder.render.replay import figures
+from sim.recorder import Recording
 from sim.worldfile import load_world
 
 
@@ -115,12 +116,12 @@ def test_the_page_allows_only_its_own_script(result: RunResult) -> None:
 
 def test_an_old_results_file_gives_the_static_picture() -> None:
     """Recordings written before commands and scans were kept: the picture as before."""
-    old = recorded("empty_room", 6)
+    old = recorded("empty_room", 6).to_dict()
     for key in ("commands", "scans", "scan"):
         del old[key]
     result = RunResult("exercise", "parameter_validation", "A velocity governor",
                        (a_test("test_governor.py", "test_clamps", "Clamped"),),
-                       recordings={"test_governor.py": old})
+                       recordings={"test_governor.py": Recording.from_dict(old)})
     page = to_html(result)
     (figure,) = _figures(page)
     assert 'class="path"' in figure and "test_governor.py" in figure

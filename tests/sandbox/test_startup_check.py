@@ -41,10 +41,7 @@ def _check(tmp_path: Path, mode: str, program: str | None = None,
     code = ("import sys\n"
             "from autograder.sandbox import startup_check\n"
             f"startup_check.TEST_PROGRAM = {program or TEST_PROGRAM!r}\n"
-            "startup_check._stop_as_ctrl_c()\n"
-            "problem = startup_check.check_launch(sys.argv[1])\n"
-            "print(problem)\n"
-            "sys.exit(problem is not None)\n")
+            "sys.exit(startup_check.main(sys.argv[1:]))\n")
     return subprocess.Popen(
         [sys.executable, "-c", code, mode], cwd=SAFE_CWD, stdout=subprocess.PIPE,
         stderr=subprocess.PIPE, text=True,
@@ -112,5 +109,5 @@ def test_where_isolation_works_the_check_passes_silently(mode, tmp_path):
     assert (run.returncode, run.stdout) == (0, ""), run.stdout + run.stderr
     # The same check, its folders (the student's own included) under tmp_path: all removed.
     status, said = _result(_check(tmp_path, mode))
-    assert (status, said) == (0, "None"), said
+    assert (status, said) == (0, ""), said
     assert list((tmp_path / "tmp").iterdir()) == []

@@ -19,15 +19,39 @@ from sim.worldfile import load_world
 REPO = Path(__file__).resolve().parents[2]
 
 
+def _python(code: str) -> subprocess.CompletedProcess[str]:
+    """``code`` run by a fresh interpreter, with this checkout first on its path."""
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(
+        filter(None, [str(REPO), os.environ.get("PYTHONPATH")]))}
+    return subprocess.run([sys.executable, "-c", code], cwd=REPO, env=env,
+                          capture_output=True, text=True, timeout=60)
+
+
 def test_sim_imports_nothing_of_autograder() -> None:
     code = ("import sys, sim.bridge, sim.cli, sim.worldfile, content, sim.faults, "
             "sim.engine, sim.svg, sim.recorder, sim.pacing, sim.procstate, sim.bag\n"
             "leaked = sorted(m for m in sys.modules if m.split('.')[0] == 'autograder')\n"
             "assert not leaked, leaked\n")
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(
-        filter(None, [str(REPO), os.environ.get("PYTHONPATH")]))}
-    result = subprocess.run([sys.executable, "-c", code], cwd=REPO, env=env,
-                            capture_output=True, text=True, timeout=60)
+    result = _python(code)
+    assert result.returncode == 0, result.stderr
+
+
+@pytest.mark.parametrize("code", [
+    "import sim.recorder",
+    # The grader's process: its command line, the results, and every grading's recordings
+    # read back (a collision among them), as the grading does for every submission.
+    "import autograder.cli, autograder.core.results, autograder.grading.run\n"
+    "from sim.recorder import Recording\n"
+    "Recording.from_dict({'world': 'obstacles', 'trajectory': [[0.1, 3, 3, 0, 0.2, 0]],\n"
+    "    'collisions': [{'t': 0.1, 'x': 3, 'y': 3, 'what': 'box 0'}],\n"
+    "    'commands': [[0, 0.2, 0]], 'scans': [[0.1, [1.5, None]]]})",
+], ids=["recorder", "grader"])
+def test_reading_a_recording_loads_neither_numpy_nor_pymunk(code: str) -> None:
+    """The grader reads a recording for every grading: numpy and pymunk would cost it
+    0.1 CPU seconds each time (issue 36); only the world's own processes load them."""
+    result = _python(code + "\nimport sys\n"
+                     "heavy = sorted({m.split('.')[0] for m in sys.modules} & {'numpy', 'pymunk'})"
+                     "\nassert not heavy, heavy\n")
     assert result.returncode == 0, result.stderr
 
 

@@ -15,7 +15,7 @@ import pytest
 from autograder.core.results import RunResult, TestResult
 from autograder.i18n import set_language
 from autograder.render.html import to_html
-from sim.recorder import Contact, Recording, Sample
+from sim.recorder import Command, Contact, Recording, Sample
 from sim.svg import scene_svg, trajectory_svg
 from sim.worldfile import load_world
 
@@ -32,7 +32,9 @@ def _english() -> Iterator[None]:
 def _recording(collisions: int = 1) -> Recording:
     samples = [Sample(t * 0.1, 3 + 0.05 * t, 3.0, 0.0, 0.5, 0.0) for t in range(30)]
     hits = [Contact(1.0 + i, 4.2, 3.0, "box 0") for i in range(collisions)]
-    return Recording(world="obstacles", samples=samples, collisions=hits)
+    # Its command makes it a run the report replays, as every run of a node's is.
+    return Recording(world="obstacles", samples=samples, collisions=hits,
+                     commands=[Command(0.0, 0.5, 0.0)])
 
 
 def _legend(svg: str) -> tuple[ET.Element, list[str]]:
@@ -108,8 +110,7 @@ def _report(lang: str, collisions: int) -> str:
                       max_score=Fraction(1), status="passed",
                       nodeid="test_a.py::test_drives")
     return to_html(RunResult("exercise", "error_handling", "Avoider", (test,), lang=lang,
-                             recordings={
-                                 "test_a.py": _recording(collisions).to_dict()}))
+                             recordings={"test_a.py": _recording(collisions)}))
 
 
 def _caption(page: str) -> str:
