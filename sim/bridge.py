@@ -38,7 +38,7 @@ import math
 import threading
 import time
 from collections import Counter
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from contextlib import AbstractContextManager
 from typing import Any
 
@@ -57,7 +57,7 @@ from sim.faults import Scan
 from sim.msgdefs import type_name
 from sim.pacing import HoldOutcome, Pacer, PacingPolicy
 from sim.physics import World
-from sim.procstate import Receiving, backlog, read_process_state, runqueue_wait_ns
+from sim.procstate import Receiving, backlog
 from sim.recorder import Recording, Sample
 from sim.worldfile import CmdVelType, Fault
 
@@ -102,6 +102,8 @@ class SimBridge:
         self.pacer = Pacer(world.dt, real_time_factor, policy, receiving=self._receiving,
                            delivering=lambda: backlog() > 0, gated=gated)
         self._cond = self.pacer.condition
+        # The watched programs' families (see watch_pid): pid -> their pids now.
+        self._families: dict[int, Callable[[], Iterable[int]]] = {}
         self._cmd: tuple[float, float] | None = None
         # Commands taken in a later tick than the one they were sent in, and the most sim
         # seconds one was late: the world's own check that no tick overtook a command.
@@ -241,8 +243,17 @@ class SimBridge:
         for tap in self._taps:
             tap(topic, type_name(type(message)), message, t)
 
-    def watch_pid(self, pid: int | None) -> None:
-        """Also hold sim time back while process ``pid`` has work (None: watch nothing)."""
+    def watch_pid(self, pid: int | None,
+                  family: Callable[[], Iterable[int]] | None = None) -> None:
+        """Also hold sim time back while process ``pid`` has work (None: watch nothing).
+        ``family()``: the pids of every process of the program now (its children and
+        daemons too), whose CPU says whether a stalled world was the program's doing
+        (:meth:`watched_family`); by default ``pid`` alone."""
+        with self._cond:
+            if pid is None:
+                self._families.clear()
+            else:
+                self._families[pid] = family or (lambda: (pid,))
         self.pacer.watch(pid)
 
     def closing_pid(self, pid: int) -> None:
@@ -252,16 +263,15 @@ class SimBridge:
 
     def unwatch_pid(self, pid: int) -> None:
         """Stop watching process ``pid``."""
+        with self._cond:
+            self._families.pop(pid, None)
         self.pacer.unwatch(pid)
 
-    def watched_usage(self) -> tuple[int, int]:
-        """CPU ns the watched processes have used, and ns they have waited for a CPU, so
-        far (summed): whether the node or the machine kept sim time back."""
-        cpu = wait = 0
-        for pid in self.pacer.watched:
-            cpu += read_process_state(pid).cpu_ns
-            wait += runqueue_wait_ns(pid)
-        return cpu, wait
+    def watched_family(self) -> set[int]:
+        """The pids of every process of the watched programs now (see :meth:`watch_pid`)."""
+        with self._cond:
+            families = list(self._families.values())
+        return {pid for family in families for pid in family()}
 
     # -- observing ------------------------------------------------------------------
     @property

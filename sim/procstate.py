@@ -20,7 +20,8 @@ from __future__ import annotations
 
 import os
 import threading
-from collections.abc import Callable
+import time
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 
 
@@ -143,6 +144,83 @@ def runqueue_wait_ns(pid: int) -> int:
         except (OSError, ValueError, IndexError):
             continue
     return waited
+
+
+ProcessKey = tuple[int, int]
+"""(pid, start time in clock ticks): a pid taken again by a new process is another key."""
+
+
+def family_usage(pids: Iterable[int]) -> dict[ProcessKey, tuple[int, int]]:
+    """For each live process of ``pids``: CPU ns used and ns waited for a CPU so far, summed
+    over its threads (``/proc/<pid>/task/*/schedstat``). One gone meanwhile is left out."""
+    usage: dict[ProcessKey, tuple[int, int]] = {}
+    for pid in pids:
+        base = f"/proc/{pid}/task/"
+        try:
+            # The start time is field 22; the fields after the ")" that closes the command
+            # name begin at field 3.
+            start = int(_read_file(f"/proc/{pid}/stat", 1024).rsplit(b")", 1)[1].split()[19])
+            tids = os.listdir(base)
+        except (OSError, ValueError, IndexError):
+            continue
+        cpu = waited = 0
+        for tid in tids:
+            try:
+                fields = _read_file(f"{base}{tid}/schedstat", 128).split()
+                cpu, waited = cpu + int(fields[0]), waited + int(fields[1])
+            except (OSError, ValueError, IndexError):
+                continue
+        usage[(pid, start)] = (cpu, waited)
+    return usage
+
+
+class UsageTally:
+    """What a family of processes (``family()``: their pids now) used over a span of wall
+    time, from readings along it: the first :meth:`read` starts the span (or the first
+    :meth:`read_if_due`, ``every`` seconds after the tally was made: most waits end
+    sooner and read nothing). Each process counts from its reading at the start, or from
+    0 if it first appears later (it was born meanwhile), to its last reading; one born and
+    gone between two readings is missed, so a wait reads every ``every`` seconds."""
+
+    def __init__(self, family: Callable[[], Iterable[int]], every: float = 0.25,
+                 clock: Callable[[], float] = time.monotonic) -> None:
+        self._family, self._every, self._clock = family, every, clock
+        self._first: dict[ProcessKey, tuple[int, int]] = {}
+        self._last: dict[ProcessKey, tuple[int, int]] = {}
+        self._began: float | None = None
+        self._due = clock() + every
+
+    def read_if_due(self) -> None:
+        if self._clock() >= self._due:
+            self.read()
+
+    def read(self) -> None:
+        now = self._clock()
+        for key, value in family_usage(self._family()).items():
+            self._first.setdefault(key, value if self._began is None else (0, 0))
+            self._last[key] = value
+        if self._began is None:
+            self._began = now
+        self._due = now + self._every
+
+    @property
+    def span_seconds(self) -> float:
+        """Wall seconds from the first reading to now (0 before it)."""
+        return 0.0 if self._began is None else self._clock() - self._began
+
+    def _summed(self, index: int) -> float:
+        return sum(last[index] - self._first[key][index]
+                   for key, last in self._last.items()) / 1e9
+
+    @property
+    def cpu_seconds(self) -> float:
+        """CPU seconds the family used over the span."""
+        return self._summed(0)
+
+    @property
+    def waited_seconds(self) -> float:
+        """Seconds its threads, summed, spent runnable but waiting for a CPU."""
+        return self._summed(1)
 
 
 def _read_file(path: str, size: int) -> bytes:

@@ -27,6 +27,7 @@ from autograder.i18n import _
 from autograder.plugin.msgtypes import CHECK_EVERY, TypeWatch, watch_world_cmd_vel
 from sim.bag import Tap
 from sim.msgdefs import type_name
+from sim.procstate import UsageTally
 
 M = TypeVar("M")
 
@@ -133,23 +134,24 @@ class Inbox(Generic[M]):
             self._sent.clear()
 
 
-def kept_busy(before: tuple[int, int], after: tuple[int, int], wall: float) -> bool:
-    """Whether the watched processes (the student's node) kept the machine busy over
-    ``wall`` seconds, from their (CPU ns, ns waited for a CPU) ``before`` and ``after``:
-    they ran for at least half of the time they were not kept waiting, and at least
-    BUSY_CPU_SECONDS.  A busy loop is running or queued for a CPU all the time, so
-    however small its share of a loaded machine, it runs whenever it is out of the queue
-    (no share of the wall time is asked: at load 12 on two cores a spinning executor got
-    less than a quarter of it, and was blamed on the machine); a node that only reacts to
-    ticks sleeps through a stalled world, so its CPU is a small part of its time out of
-    the queue.  Below that the machine is to blame."""
-    cpu = (after[0] - before[0]) / 1e9
-    waited = (after[1] - before[1]) / 1e9
+def kept_busy(cpu: float, waited: float, wall: float) -> bool:
+    """Whether the watched program (its node, and every process it started) kept the
+    machine busy over ``wall`` seconds, from the CPU seconds it used and the seconds its
+    threads waited for a CPU meanwhile (summed): it ran for at least half of the time it
+    was not kept waiting, and at least BUSY_CPU_SECONDS.  A busy loop is running or queued
+    for a CPU all the time, so however small its share of a loaded machine, it runs
+    whenever it is out of the queue (no share of the wall time is asked: at load 12 on two
+    cores a spinning executor got less than a quarter of it, and was blamed on the
+    machine); a node that only reacts to ticks sleeps through a stalled world, so its CPU
+    is a small part of its time out of the queue.  Children that spin to starve the world
+    count as the program's.  Below that the machine is to blame."""
     return cpu >= max(BUSY_CPU_SECONDS, 0.5 * (wall - waited))
 
 
 BUSY_CPU_SECONDS = 0.5
 """The least CPU a node must have used in a stalled wait to be what stalled it."""
+TALLY_EVERY = 0.25
+"""Wall seconds between readings of the program's processes during a wait."""
 
 
 class Probe:
@@ -227,16 +229,25 @@ class Probe:
 
         if condition():
             return True
-        usage = getattr(self.world, "watched_usage", None)
-        before, began = (usage() if usage else None), time.monotonic()
-        done = self.world.wait_for(lambda: condition() or elapsed(),
-                                   sim_timeout=sim_timeout, wall_timeout=wall)
+        # What the program's processes use during the wait, read every TALLY_EVERY.
+        family = getattr(self.world, "watched_family", None)
+        tally = UsageTally(family, TALLY_EVERY) if family is not None else None
+        began = time.monotonic()
+
+        def done_waiting() -> bool:
+            if tally is not None:
+                tally.read_if_due()
+            return condition() or elapsed()
+
+        done = self.world.wait_for(done_waiting, sim_timeout=sim_timeout, wall_timeout=wall)
         if condition():
             return True
         if not done and not elapsed():
             took = time.monotonic() - began
-            if before is not None and usage is not None and \
-                    not kept_busy(before, usage(), took):
+            if tally is not None:
+                tally.read()
+            if tally is not None and not kept_busy(tally.cpu_seconds, tally.waited_seconds,
+                                                   tally.span_seconds):
                 raise GraderError(
                     _("The simulation could not advance for {seconds:.0f} s of wall time, and "
                       "the node was not what kept it busy: the machine was too busy to grade. "

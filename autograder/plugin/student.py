@@ -165,7 +165,7 @@ def _launch(request: pytest.FixtureRequest, exercise: Exercise, script: Path, pr
             str(process.workdir) if process.uid is not None else None, process.uid)
         process.gate = reporter.spawn_gate
     process.start()
-    world.watch_pid(process.pid)
+    world.watch_pid(process.pid, process.family)
     node = StudentNode(process, exercise.node, probe, _log_keeper(request),
                        shown_folder(request.config.stash[settings_key].submission_name))
     if wait_for_node:

@@ -32,7 +32,7 @@ from autograder.core.exercise import Limits
 from autograder.sandbox.cgroups import Cgroup
 from autograder.sandbox.contained import runner
 from autograder.sandbox.privileged import PACKAGE_PARENT, SAFE_CWD, module_command
-from autograder.sandbox.sweep import is_student_uid, sweep_user
+from autograder.sandbox.sweep import is_student_uid, sweep_user, user_processes
 
 _PASS_THROUGH = (
     "PATH", "LD_LIBRARY_PATH", "PYTHONPATH", "AMENT_PREFIX_PATH", "ROS_DISTRO", "ROS_VERSION",
@@ -89,6 +89,25 @@ def student_process(script: Path, ros_args: list[str], limits: Limits, *, domain
         if isolation.strict:
             process.hide = protected_paths(course)
     return process
+
+
+def descendants(pid: int) -> set[int]:
+    """``pid`` and every live process below it (``/proc/<pid>/task/*/children``)."""
+    found, todo = set(), [pid]
+    while todo:
+        current = todo.pop()
+        if current in found:
+            continue
+        try:
+            tids = os.listdir(f"/proc/{current}/task")
+        except OSError:
+            continue
+        found.add(current)
+        for tid in tids:
+            with contextlib.suppress(OSError, ValueError):
+                with open(f"/proc/{current}/task/{tid}/children", "rb") as fh:
+                    todo.extend(int(child) for child in fh.read().split())
+    return found
 
 
 def student_python() -> str:
@@ -411,6 +430,19 @@ class StudentProcess:
 
     def running(self) -> bool:
         return self.popen is not None and self.popen.poll() is None
+
+    def family(self) -> set[int]:
+        """The program's processes now: its cgroup's where it has one; else, where it runs
+        as a user of its own (strict isolation, isolation by user), every process of that
+        user, daemons that left it included; else (basic isolation) its process and their
+        descendants (one that left them, reparented, is not found)."""
+        if self.popen is None:
+            return set()
+        if self.cgroup is not None and self.cgroup.available:
+            return self.cgroup.pids()
+        if self.uid is not None and is_student_uid(self.uid):
+            return set(user_processes(self.uid))
+        return descendants(self.pid)
 
     def wait(self, timeout: float) -> int | None:
         """Wait (wall time) for the process to exit; its status, or None if it still runs."""

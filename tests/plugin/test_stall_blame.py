@@ -1,30 +1,35 @@
-"""Whose failure a stalled wait is: the node's if it kept the CPU busy, else the machine's."""
+"""Whose failure a stalled wait is: the program's if it (its node, or any process it
+started) kept the CPU busy, else the machine's."""
 
 from autograder.plugin.probe import kept_busy
-
-S = 1_000_000_000  # ns
 
 
 def test_a_busy_loop_is_blamed_even_on_a_loaded_machine():
     # 10 s of wall time: running 4 s, waiting for a CPU the other 6 (never asleep).
-    assert kept_busy((0, 0), (4 * S, 6 * S), 10.0)
+    assert kept_busy(4.0, 6.0, 10.0)
 
 
 def test_a_busy_loop_given_a_small_share_of_a_crowded_machine_is_blamed():
     # 12 s of wall time at load 12 on two cores: running 2 s, queued the other 10.
-    assert kept_busy((0, 0), (2 * S, 10 * S), 12.0)
+    assert kept_busy(2.0, 10.0, 12.0)
 
 
 def test_an_idle_node_on_a_starved_machine_is_not_blamed():
     # It ran 0.3 s and waited 2 s: the rest of the 10 s it slept, waiting for ticks.
-    assert not kept_busy((0, 0), (S * 3 // 10, 2 * S), 10.0)
+    assert not kept_busy(0.3, 2.0, 10.0)
 
 
 def test_a_node_kept_waiting_all_along_is_not_blamed():
     # Four threads queued for a CPU for 9 s each, 0.3 s of CPU between them: waits add up
     # past the wall time, and what ran is below BUSY_CPU_SECONDS.
-    assert not kept_busy((5 * S, 0), (5 * S + 3 * S // 10, 36 * S), 10.0)
+    assert not kept_busy(0.3, 36.0, 10.0)
+
+
+def test_children_spinning_to_starve_the_world_are_the_programs_doing():
+    # An idle node and 100 children that spin on 2 cores for 10 s: the family ran about
+    # 19 s and queued about 980 s between them.
+    assert kept_busy(19.0, 980.0, 10.0)
 
 
 def test_nothing_watched_is_never_the_node():
-    assert not kept_busy((0, 0), (0, 0), 12.0)
+    assert not kept_busy(0.0, 0.0, 12.0)

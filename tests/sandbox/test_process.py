@@ -11,6 +11,7 @@ import subprocess
 import sys
 import sysconfig
 import tempfile
+import time
 from collections.abc import Iterator
 from pathlib import Path
 from xml.etree import ElementTree
@@ -29,6 +30,7 @@ from autograder.sandbox.isolation import (
 from autograder.sandbox.process import (
     STRICT_WORKDIR_PREFIX,
     LaunchFailed,
+    descendants,
     reap_recorded,
     student_process,
 )
@@ -65,6 +67,43 @@ def test_a_program_that_fails_at_once_is_the_programs_failure(tmp_path):
     assert process.wait(30) == 1
     process.stop()
     assert "mine" in process.output_text()
+
+
+_FAMILY = """import os, sys, time
+for _ in range(2):
+    if os.fork() == 0:  # a child, and its own child
+        if os.fork() == 0:
+            time.sleep(60)
+            os._exit(0)
+        time.sleep(60)
+        os._exit(0)
+print("forked", flush=True)
+time.sleep(60)
+"""
+
+
+def test_a_programs_family_is_every_process_it_started(tmp_path):
+    """What a stalled wait counts as the program's (autograder/plugin/probe.py): its
+    processes and their children, however the machine lets the grader find them (here
+    basic isolation: no user of its own; with a cgroup where one can be made)."""
+    process = student_process(_program(tmp_path, _FAMILY), [], Limits(), domain=0,
+                              strict=False, course=COURSE)
+    process.start()
+    try:
+        deadline = time.monotonic() + 30
+        while "forked" not in process.output_text() and time.monotonic() < deadline:
+            time.sleep(0.05)
+        family = process.family()
+        assert process.pid in family and len(family) == 5, family
+        assert descendants(process.pid) == family  # none has left the tree
+    finally:
+        process.stop()
+
+
+def test_descendants_of_a_process_that_is_gone_is_nothing():
+    gone = subprocess.Popen([sys.executable, "-c", "pass"])
+    gone.wait()
+    assert descendants(gone.pid) == set()
 
 
 def test_the_program_gets_the_runs_fast_dds_profile_in_its_own_folder(tmp_path):

@@ -298,3 +298,32 @@ def test_scratch_files_are_swept(shape_run):
     assert not [name for name in names if Path(name).exists()]
     for uid in g.results["isolation"]["student_uids"]:
         assert user_ipc(uid) == []
+
+
+STALL = REPO / "tests" / "submissions" / "stalls" / "starves_the_world"
+
+
+@pytest.mark.parametrize("prefix", [(), SHAPES[0].prefix], ids=["strict", "container"])
+def test_children_that_starve_the_world_fail_the_program_not_the_machine(prefix):
+    """A silent node whose 100 spinning children starve the world (without a cgroup, in
+    the container, every wait stalls): the program's zero, never "the machine was too
+    busy" (a grader error, graded again). Graded alone: beside it a classmate's stalled
+    grading would rightly be the machine's failure."""
+    work = world_readable_folder("autograder-stall-")
+    try:
+        shutil.copytree(MINI, work / "course")
+        shutil.copytree(STALL, work / "submission")
+        for path in [work, *work.rglob("*")]:
+            path.chmod(0o777 if path.is_dir() else 0o644)
+        env = {**clean_env(os.environ.get("PATH", "")), "HOME": str(work),
+               "AUTOGRADER_COURSE": str(work / "course")}
+        done = subprocess.run([*prefix, str(AUTOGRADER), "grade", "shout",
+                               str(work / "submission"), "--results",
+                               str(work / "results.json")],
+                              env=env, cwd=work, capture_output=True, text=True, timeout=600)
+        results = json.loads((work / "results.json").read_text())
+        assert results["grader_error"] is None, done.stdout[-3000:] + done.stderr[-3000:]
+        assert done.returncode == 0
+        assert results["score"] <= 1  # the node starts; it never answers
+    finally:
+        shutil.rmtree(work, ignore_errors=True)

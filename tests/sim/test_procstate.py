@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import signal
 import subprocess
 import sys
 import time
@@ -14,7 +15,9 @@ from sim.pacing import DEFAULT_CPU_BUDGET
 from sim.procstate import (
     IDLE,
     Receiving,
+    UsageTally,
     backlog,
+    family_usage,
     process_busy,
     read_process_state,
 )
@@ -233,3 +236,52 @@ def test_kept_files_follow_threads_that_come_and_go_and_close_with_the_process()
         proc.stdout.close()
     assert read_process_state(proc.pid) == IDLE  # gone: its files are closed
     assert _open_fds() == before
+
+
+def test_family_usage_keys_each_process_by_pid_and_start():
+    spinner = _spinning()
+    try:
+        usage = family_usage([spinner.pid, os.getpid(), 2**22 + 7])  # the last: no such pid
+        assert {pid for pid, _start in usage} == {spinner.pid, os.getpid()}
+        cpu, waited = usage[next(k for k in usage if k[0] == spinner.pid)]
+        assert cpu > 0 and waited >= 0
+    finally:
+        spinner.kill()
+        spinner.wait()
+
+
+def test_a_tally_counts_a_process_from_its_first_reading_and_one_born_later_whole():
+    procs = [_spinning()]
+    family = [procs[0].pid]
+    tally = UsageTally(lambda: family, every=0.0)
+    try:
+        tally.read()
+        assert tally.cpu_seconds == 0  # what it ran before the span is not counted
+        procs.append(_spinning())
+        family.append(procs[1].pid)
+        assert _poll(lambda: (tally.read(), tally.cpu_seconds)[1] >= 0.4)
+        # The young one counts from 0 (its start, inside the span), the old one from the
+        # first reading: stopped, so its CPU time holds still, the young one's whole CPU
+        # time is in the sum.
+        os.kill(procs[1].pid, signal.SIGSTOP)
+        tally.read()
+        young = sum(cpu for cpu, _w in family_usage([procs[1].pid]).values()) / 1e9
+        assert young > 0.05 and tally.cpu_seconds >= young
+        assert tally.span_seconds > 0
+    finally:
+        for proc in procs:
+            proc.kill()
+            proc.wait()
+
+
+def test_a_tally_reads_nothing_before_it_is_due():
+    calls = []
+    now = [100.0]
+    tally = UsageTally(lambda: calls.append(1) or [], every=0.25, clock=lambda: now[0])
+    tally.read_if_due()
+    assert calls == [] and tally.span_seconds == 0.0
+    now[0] += 0.3
+    tally.read_if_due()
+    assert calls == [1]
+    now[0] += 1.0
+    assert tally.span_seconds == 1.0
