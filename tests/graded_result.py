@@ -7,6 +7,7 @@ from __future__ import annotations
 from fractions import Fraction
 
 from autograder.core.results import (
+    IntervalChart,
     RunResult,
     TestResult,
 )
@@ -20,9 +21,8 @@ def graded_result(lang: str = "en", grader_error: str | None = None) -> RunResul
         TestResult("test_rate", "cmd_vel keeps 10 Hz", Fraction(0), Fraction(2), "failed",
                    message="`cmd_vel` came at 3.1 Hz <script>alert(1)</script>",
                    hint="Is the planner in its own callback group?",
-                   charts=({"kind": "intervals", "title": "cmd_vel",
-                            "points": [[0.1, 0.1], [0.2, 0.1], [0.9, 0.7]],
-                            "limit": 0.15},)),
+                   charts=(IntervalChart("cmd_vel", ((0.1, 0.1), (0.2, 0.1), (0.9, 0.7)),
+                                         0.15),)),
         TestResult("test_hidden", "Refuses bad values", Fraction(0), Fraction(2), "failed",
                    message=SECRET, hint=SECRET, visibility="after_published",
                    reveal="status"),

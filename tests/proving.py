@@ -319,7 +319,8 @@ def diagnosis(result: RunResult) -> dict[str, Any]:
     """What a failed proof prints of a grading: what each lost test said and measured, how
     the world paced itself, where the time went (a verdict that changed under load says
     why)."""
-    charts = {t.name: t.charts for t in result.tests if t.status != "passed" and t.charts}
+    charts = {t.name: [c.to_dict() for c in t.charts] for t in result.tests
+              if t.status != "passed" and t.charts}
     return {"lost": failures(result), "grader_error": result.grader_error,
             "grader_details": result.grader_details[-2000:],
             # What the lost tests measured (e.g. when each rate report came), so a verdict

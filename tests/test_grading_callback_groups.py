@@ -90,7 +90,7 @@ def test_report_plots_the_scan_rate_reports(graded):
     charts = {t.name: t.charts for t in result.tests}
     for name in ("test_scan_rate", "test_concurrent_requests", "test_never_deadlocks"):
         (chart,) = charts[name]
-        assert chart["title"] == "scans_per_second" and chart["points"], name
-        assert all(0.5 <= gap <= 1.5 for _t, gap in chart["points"]), (name, chart)
+        assert chart.title == "scans_per_second" and chart.points, name
+        assert all(0.5 <= gap <= 1.5 for _t, gap in chart.points), (name, chart)
     page = to_html(result, find_exercise("callback_groups").folder)
     assert page.count('class="chart"') == 3

@@ -84,13 +84,13 @@ def test_report_plots_the_intervals_each_rate_test_measured(graded):
     result = graded["reference#0"]
     charts = {t.name: t.charts for t in result.tests}
     (control,) = charts["test_control_rate"]
-    assert control["title"] == "cmd_vel"
-    assert control["limit"] == pytest.approx(0.15)  # the largest gap allowed
-    assert len(control["points"]) > 100  # 12 s at 10 Hz, less what discovery took
-    assert all(gap <= control["limit"] for _t, gap in control["points"])  # the reference keeps it
+    assert control.title == "cmd_vel"
+    assert control.limit == pytest.approx(0.15)  # the largest gap allowed
+    assert len(control.points) > 100  # 12 s at 10 Hz, less what discovery took
+    assert all(gap <= control.limit for _t, gap in control.points)  # the reference keeps it
     assert len(charts["test_control_while_planning"]) == 1  # one per planner run
     for name in ("test_status_rate", "test_plan_rate", "test_rates_at_half_speed"):
-        assert [len(c["points"]) > 0 for c in charts[name]] == [True], name
+        assert [len(c.points) > 0 for c in charts[name]] == [True], name
     page = to_html(result, find_exercise("timer_sync").folder)
     assert page.count('<svg xmlns="http://www.w3.org/2000/svg" class="chart"') == sum(
         len(c) for c in charts.values())

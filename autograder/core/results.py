@@ -44,6 +44,42 @@ def number(value: Fraction) -> int | float:
 
 
 @dataclasses.dataclass(frozen=True)
+class IntervalChart:
+    """A test's message-interval plot (:meth:`autograder.plugin.credit.Evidence.intervals`):
+    ``points``, each message's simulation time and the gap since the one before, in
+    seconds; ``limit``, the largest gap allowed (None: no line drawn)."""
+
+    title: str
+    points: tuple[tuple[float, float], ...] = ()
+    limit: float | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        """As the child's raw report carries it (``kind`` names the chart's type)."""
+        return {"kind": "intervals", "title": self.title,
+                "points": [[t, gap] for t, gap in self.points], "limit": self.limit}
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> IntervalChart:
+        """Read what :meth:`to_dict` wrote; another shape is a KeyError, TypeError or
+        ValueError here (a point that is not a pair of numbers), never later, in a drawing."""
+        if data.get("kind", "intervals") != "intervals":
+            raise ValueError(f"not an intervals chart: {data.get('kind')!r}")
+        title, limit = data["title"], data.get("limit")
+        if not isinstance(title, str):
+            raise TypeError(f"a chart's title is text, not {title!r}")
+        return cls(title=title,
+                   points=tuple((_real(t), _real(gap)) for t, gap in data["points"]),
+                   limit=None if limit is None else _real(limit))
+
+
+def _real(value: Any) -> float:
+    """``value`` if it is a number (an int as read from JSON stays one), else TypeError."""
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise TypeError(f"not a number: {value!r}")
+    return value
+
+
+@dataclasses.dataclass(frozen=True)
 class TestResult:
     """The outcome of one test (or one quiz question)."""
 
@@ -63,8 +99,9 @@ class TestResult:
     core: bool = False
     # pytest's id of the test (``tests/public/test_x.py::test_y``); empty for a question.
     nodeid: str = ""
-    # The charts the test drew (see ``autograder.plugin.credit``), for the HTML report.
-    charts: tuple[Mapping[str, Any], ...] = ()
+    # The charts the test drew (see ``autograder.plugin.credit``), for the HTML report only
+    # (never in the JSON results).
+    charts: tuple[IntervalChart, ...] = ()
     # A quiz question's answer as the student gave it (None: not answered).
     answer: Any = None
 

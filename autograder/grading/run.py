@@ -24,6 +24,7 @@ from autograder.core.exercise import Exercise
 from autograder.core.report import RawReport, RawTest
 from autograder.core.results import (
     Containment,
+    IntervalChart,
     MemoryUse,
     ModulePacing,
     NotRun,
@@ -299,7 +300,21 @@ def result_of(raw: RawTest, status: str | None = None,
         max_score=max_score, status=status,  # type: ignore[arg-type]
         message=raw.message if message is None else message, hint=raw.hint,
         visibility=raw.visibility, reveal=raw.reveal,  # type: ignore[arg-type]
-        details=raw.details, core=raw.core, nodeid=raw.nodeid, charts=tuple(raw.charts))
+        details=raw.details, core=raw.core, nodeid=raw.nodeid, charts=_charts(raw.charts))
+
+
+def _charts(carried: Sequence[Mapping[str, Any]]) -> tuple[IntervalChart, ...]:
+    """The charts a test drew, read back from the raw report
+    (:meth:`~autograder.core.results.IntervalChart.to_dict`). One that cannot be read is
+    left out, as a recording is: the report draws it not at all, and the grade does not
+    change."""
+    charts = []
+    for data in carried:
+        try:
+            charts.append(IntervalChart.from_dict(data))
+        except (AttributeError, KeyError, TypeError, ValueError):  # not a chart's shape
+            continue
+    return tuple(charts)
 
 
 def _score(status: str, max_score: Fraction, fraction: float | None) -> Fraction:

@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 import itertools
-from typing import Any
 
 import pytest
 
+from autograder.core.results import IntervalChart
 from autograder.plugin.stash import credit_key, evidence_key
 
 
@@ -31,14 +31,14 @@ class Evidence:
     """Data a test attaches for the report's pictures (e.g. message intervals)."""
 
     def __init__(self) -> None:
-        self.charts: list[dict[str, Any]] = []
+        self.charts: list[IntervalChart] = []
 
     def intervals(self, title: str, times: list[float], limit: float | None = None) -> None:
         """Plot the gaps between messages over simulation time (``limit``: the allowed gap)."""
-        points = [(round(b, 3), round(b - a, 4)) for a, b in itertools.pairwise(times)]
+        points = tuple((round(b, 3), round(b - a, 4)) for a, b in itertools.pairwise(times))
         # Rounded as the gaps are: a test's 0.15 + 1e-6 is drawn and labelled 0.15.
-        self.charts.append({"kind": "intervals", "title": title, "points": points,
-                            "limit": None if limit is None else round(limit, 4)})
+        self.charts.append(IntervalChart(title, points,
+                                         None if limit is None else round(limit, 4)))
 
 
 @pytest.fixture

@@ -172,7 +172,7 @@ class GradingReporter:
             return
         shown = item.stash.get(evidence_key, None)
         if shown is not None and call.when == "call":
-            entry.charts = shown.charts
+            entry.charts = [chart.to_dict() for chart in shown.charts]
         if call.when == "setup" or call.when == "call":
             given = item.stash.get(credit_key, None)
             if outcome_report.passed and call.when == "call" and given \

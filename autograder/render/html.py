@@ -36,10 +36,9 @@ def _tests(result: RunResult, lang: str) -> list[dict[str, Any]]:
             "label": Text(core_label(test), lang),
             "message": Text(test.student_message, lang) if test.student_message else None,
             "hint": Text(test.student_hint, lang) if test.student_hint else None,
-            "charts": [{"svg": intervals_svg([tuple(p) for p in chart["points"]],
-                                             chart.get("limit"), chart["title"]),
-                        "limit": chart.get("limit") is not None}
-                       for chart in test.charts if chart.get("points")],
+            "charts": [{"svg": intervals_svg(list(chart.points), chart.limit, chart.title),
+                        "limit": chart.limit is not None}
+                       for chart in test.charts if chart.points],
             "score": number(test.score), "max_score": number(test.max_score),
         })
     return tests

@@ -8,12 +8,16 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import re
 from decimal import Decimal
 from fractions import Fraction
 from pathlib import Path
 
+import pytest
+
 from autograder.core.results import (
     Containment,
+    IntervalChart,
     MemoryUse,
     ModulePacing,
     NotRun,
@@ -42,11 +46,15 @@ def failed(name: str, points: int = 1, core: bool = False) -> TestResult:
                       message="it did not", hint="try", core=core)
 
 
+CHART = IntervalChart("cmd_vel", ((0.1, 0.1), (0.25, 0.15), (1, 0.75)), 0.15)
+
+
 def full_run() -> RunResult:
-    """A grading with every field the results file holds."""
+    """A grading with every field the results file holds (and a chart, which it does not)."""
     return RunResult(
         "exercise", "shout", "Shout", (passed("test_starts", 3, core=True),
-                                       failed("test_shouts", 2)),
+                                       dataclasses.replace(failed("test_shouts", 2),
+                                                           charts=(CHART,))),
         execution_time=12.3456, log="never in the JSON",
         isolation=Containment.from_dict({**Isolation("strict").to_dict(),
                                          "bounds": {"cgroup": "v2", "processes": "cgroup",
@@ -129,11 +137,43 @@ def test_every_field_of_the_file_reads_back_typed() -> None:
         assert getattr(again, field) == getattr(run, field), field
     assert again.execution_time == 12.346  # rounded to the ms in the file
     assert again.log == ""  # the programs' output goes beside the file, never in it
+    assert again.tests[1].charts == ()  # the charts are the HTML report's, never in it
     assert [(t.name, t.score, t.max_score, t.status, t.core) for t in again.tests] == [
         (t.name, t.score, t.max_score, t.status, t.core) for t in run.tests]
     assert isinstance(again.isolation, Containment)
     assert again.isolation.bounds == ProcessBounds("v2", "cgroup", "cgroup", "cgroup")
     assert again.isolation.student_uids == (61007, 61008)
+
+
+def test_a_chart_reads_back_as_the_child_wrote_it() -> None:
+    """The child's raw report carries each chart as :meth:`IntervalChart.to_dict` writes
+    it; read back, it is the same chart, its whole times still whole."""
+    written = json.dumps(CHART.to_dict())
+    assert written == ('{"kind": "intervals", "title": "cmd_vel", '
+                       '"points": [[0.1, 0.1], [0.25, 0.15], [1, 0.75]], "limit": 0.15}')
+    assert IntervalChart.from_dict(json.loads(written)) == CHART
+    assert json.dumps(IntervalChart.from_dict(json.loads(written)).to_dict()) == written
+    assert IntervalChart.from_dict({"title": "odom", "points": []}) == IntervalChart("odom")
+
+
+@pytest.mark.parametrize(("data", "error", "says"), [
+    ({"title": "t", "points": [[0.1, 0.1, 0.1]]}, ValueError, "too many values"),
+    ({"title": "t", "points": [[0.1]]}, ValueError, "not enough values"),
+    ({"title": "t", "points": [0.1]}, TypeError, "cannot unpack"),
+    ({"title": "t", "points": [["0.1", 0.1]]}, TypeError, "not a number: '0.1'"),
+    ({"title": "t", "points": [[0.1, None]]}, TypeError, "not a number: None"),
+    ({"title": "t", "points": [], "limit": True}, TypeError, "not a number: True"),
+    ({"title": 3, "points": []}, TypeError, "title is text"),
+    ({"kind": "bars", "title": "t", "points": []}, ValueError, "not an intervals chart"),
+    ({"title": "t"}, KeyError, "points"),
+], ids=["triple", "single", "no-pair", "text-time", "no-gap", "bool-limit", "title",
+        "kind", "no-points"])
+def test_a_chart_of_another_shape_is_an_error_when_it_is_read(
+        data: dict[str, object], error: type[Exception], says: str) -> None:
+    """As the other fields' ``from_dict`` fail (a KeyError, TypeError or ValueError), so
+    that a reader leaves the chart out, never draws it wrong."""
+    with pytest.raises(error, match=re.escape(says)):
+        IntervalChart.from_dict(data)
 
 
 def test_a_quiz_or_a_fault_writes_none_of_the_gradings_fields() -> None:

@@ -12,7 +12,7 @@ import pytest
 from autograder.core import report
 from autograder.core.exercise import load_exercise
 from autograder.core.report import RawReport, RawTest
-from autograder.core.results import RunResult
+from autograder.core.results import IntervalChart, RunResult
 from autograder.grading.children import Child, Ended
 from autograder.grading.module_groups import children_for, find_modules, merge, share_out
 from autograder.grading.run import GRADER_FAULT, verdict
@@ -227,6 +227,22 @@ def test_each_modules_recording_is_read_back_and_one_unreadable_left_out() -> No
     assert list(result.recordings) == ["test_p.py"]
     assert result.recordings["test_p.py"] == recorded
     assert [(t.name, t.status) for t in result.tests] == [("p", "passed")]  # graded as ever
+
+
+def test_each_tests_charts_are_read_back_and_one_unreadable_left_out() -> None:
+    """A chart is only a picture in the report: one the raw report carries in another
+    shape (a point that is not a pair, a time that is not a number) is not drawn, and the
+    test is graded as ever."""
+    drawn = IntervalChart("cmd_vel", ((0.1, 0.1), (0.2, 0.1)), 0.15)
+    unreadable = [{"kind": "intervals", "title": "odom", "points": [[0.1, 0.1, 0.1]]},
+                  {"kind": "intervals", "title": "odom", "points": [["0.1", 0.1]]},
+                  {"kind": "intervals", "title": "odom", "points": [0.1]},
+                  {"kind": "bars", "title": "odom", "points": []}, {"title": "odom"}, []]
+    charted = dataclasses.replace(_test(PUBLIC, "p"),
+                                  charts=[drawn.to_dict(), *unreadable, drawn.to_dict()])
+    result = _outcome(_ended(charted, returncode=0))
+    assert result.tests[0].charts == (drawn, drawn)
+    assert [(t.name, t.status) for t in result.tests] == [("p", "passed")]
 
 
 @pytest.mark.parametrize(("options", "expected"), [

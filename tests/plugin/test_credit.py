@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import pytest
 
+from autograder.core.results import IntervalChart
 from autograder.plugin.credit import Credit, Evidence
 
 
@@ -27,9 +28,8 @@ def test_intervals_are_the_gaps_at_each_messages_time():
     shown.intervals("cmd_vel", [1.0, 1.1, 1.3000004, 1.35], limit=0.15 + 1e-6)
     shown.intervals("odom", [2.0])  # one message: no gap yet
     first, second = shown.charts
-    assert first == {"kind": "intervals", "title": "cmd_vel", "limit": 0.15,
-                     "points": [(1.1, 0.1), (1.3, 0.2), (1.35, 0.05)]}
-    assert second == {"kind": "intervals", "title": "odom", "points": [], "limit": None}
+    assert first == IntervalChart("cmd_vel", ((1.1, 0.1), (1.3, 0.2), (1.35, 0.05)), 0.15)
+    assert second == IntervalChart("odom", (), None)
 
 
 def test_each_fixture_is_the_running_tests_own(pytester: pytest.Pytester) -> None:

@@ -16,6 +16,7 @@ from typing import Any
 import pytest
 
 from autograder.core.output_budget import CUT, DETAILS_BYTES, MESSAGE_BYTES
+from autograder.core.results import IntervalChart
 from autograder.core.settings import RunSettings
 from autograder.core.signing import Forged, verify
 
@@ -170,6 +171,24 @@ def test_partial_credit_is_a_failure_with_its_fraction(pytester: pytest.Pytester
     entry = tests["test_award_then_fail"]
     assert (entry["status"], entry["message"]) == ("failed", "then it crashed")
     assert entry["fraction"] is None
+
+
+def test_a_drawn_chart_goes_in_the_report_as_its_dict(pytester: pytest.Pytester) -> None:
+    """The signed report is JSON: each chart a test drew is carried as
+    :meth:`IntervalChart.to_dict` writes it, and read back as the chart it was."""
+    tests = grade_tests(pytester, '''
+        def test_rate(evidence):
+            evidence.intervals("cmd_vel", [1.0, 1.1, 1.3], limit=0.15)
+
+        def test_no_chart():
+            pass
+    ''')
+    (carried,) = tests["test_rate"]["charts"]
+    assert carried == {"kind": "intervals", "title": "cmd_vel",
+                       "points": [[1.1, 0.1], [1.3, 0.2]], "limit": 0.15}
+    assert IntervalChart.from_dict(carried) == IntervalChart(
+        "cmd_vel", ((1.1, 0.1), (1.3, 0.2)), 0.15)
+    assert tests["test_no_chart"]["charts"] == []
 
 
 def test_a_type_mismatch_leads_every_failure_once(pytester: pytest.Pytester) -> None:

@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 from browser import chromium_page, fonts_used, ink
 
-from autograder.core.results import RunResult, TestResult
+from autograder.core.results import IntervalChart, RunResult, TestResult
 from autograder.render.html import to_html
 from sim.recorder import Recording, Sample
 from sim.worldfile import Fault
@@ -30,9 +30,8 @@ def urdu_result() -> RunResult:
                    "failed", message="`cmd_vel` simulation time میں 3.1 Hz پر آیا؛ planner "
                    "کے چلتے ہوئے بھی control loop کو 10 Hz رکھنا ہے۔",
                    hint="کیا planner اپنے callback group میں ہے؟",
-                   charts=({"kind": "intervals", "title": "cmd_vel",
-                            "points": [[0.1 * i, 0.1] for i in range(1, 30)]
-                            + [[3.5, 0.6]], "limit": 0.15},)),
+                   charts=(IntervalChart("cmd_vel", (*((0.1 * i, 0.1) for i in range(1, 30)),
+                                                     (3.5, 0.6)), 0.15),)),
     )
     return RunResult("exercise", "timer_sync", "Timer synchronization: ایک multi-rate controller",
                      tests, lang="ur", log_tail="[INFO] [multi_rate_controller]: started",
