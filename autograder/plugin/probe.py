@@ -140,10 +140,9 @@ def kept_busy(cpu: float, waited: float, wall: float) -> bool:
     threads waited for a CPU meanwhile (summed): it ran for at least half of the time it
     was not kept waiting, and at least BUSY_CPU_SECONDS.  A busy loop is running or queued
     for a CPU all the time, so however small its share of a loaded machine, it runs
-    whenever it is out of the queue (no share of the wall time is asked: at load 12 on two
-    cores a spinning executor got less than a quarter of it, and was blamed on the
-    machine); a node that only reacts to ticks sleeps through a stalled world, so its CPU
-    is a small part of its time out of the queue.  Children that spin to starve the world
+    whenever it is out of the queue (no share of the wall time is asked: a crowded machine
+    gives a spinning executor little of it); a node that only reacts to ticks sleeps
+    through a stalled world, so its CPU is a small part of its time out of the queue.  Children that spin to starve the world
     count as the program's.  Below that the machine is to blame."""
     return cpu >= max(BUSY_CPU_SECONDS, 0.5 * (wall - waited))
 
