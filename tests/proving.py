@@ -55,8 +55,9 @@ SUBMISSIONS = Path(__file__).parent / "submissions"
 JOBS = int(os.environ.get("AUTOGRADER_TEST_JOBS", "2"))
 EXPECT = "expect.yaml"
 KINDS = ("correct", "mutant", "broken")
-# Folders under tests/submissions that are not an exercise's proof (test_hostile.py's).
-NOT_PROOFS = ("hostile",)
+# Folders under tests/submissions that are not an exercise's proof: test_hostile.py's
+# corpus, and the programs test_shapes.py grades alone (they would starve a grading beside).
+NOT_PROOFS = ("hostile", "stalls")
 
 
 class PatchError(ValueError):
