@@ -142,8 +142,9 @@ def kept_busy(cpu: float, waited: float, wall: float) -> bool:
     for a CPU all the time, so however small its share of a loaded machine, it runs
     whenever it is out of the queue (no share of the wall time is asked: a crowded machine
     gives a spinning executor little of it); a node that only reacts to ticks sleeps
-    through a stalled world, so its CPU is a small part of its time out of the queue.  Children that spin to starve the world
-    count as the program's.  Below that the machine is to blame."""
+    through a stalled world, so its CPU is a small part of its time out of the queue.
+    Children that spin to starve the world count as the program's.  Below that the
+    machine is to blame."""
     return cpu >= max(BUSY_CPU_SECONDS, 0.5 * (wall - waited))
 
 
