@@ -31,20 +31,35 @@ print("autograder-check-ok", os.getuid())
 
 def check_launch(mode: Mode = "strict") -> str | None:
     """Start a test program exactly as a student's is started in isolation ``mode``; None
-    if it ran as its own user, else what went wrong. Runs inside the run's namespaces."""
+    if it ran as its own user, else what went wrong. Runs inside the run's namespaces.
+
+    The program runs as the user of a domain held for the check, as a grading holds its
+    own: no other check or grading uses that user meanwhile (the end of a program sweeps
+    every process of its user)."""
+    from autograder.sandbox.domains import NoDomain, hold_domain
+
+    if mode == "strict":
+        bring_up_loopback()
+    try:
+        with hold_domain() as lock:
+            return _test_program(mode, lock.domain)
+    except NoDomain as exc:
+        return str(exc)
+
+
+def _test_program(mode: Mode, domain: int) -> str | None:
+    """:func:`check_launch`'s test program, run as ``domain``'s student user."""
     import tempfile
 
     from autograder.core.exercise import Limits
     from autograder.sandbox.process import LaunchFailed, student_process
 
-    if mode == "strict":
-        bring_up_loopback()
     with tempfile.TemporaryDirectory(prefix="autograder-check-",
                                      ignore_cleanup_errors=True) as tmp:
         script = Path(tmp) / "staged" / "check.py"
         script.parent.mkdir()
         script.write_text(TEST_PROGRAM)
-        process = student_process(script, [], Limits(), domain=0, mode=mode,
+        process = student_process(script, [], Limits(), domain=domain, mode=mode,
                                   course=Path(PACKAGE_PARENT))
         try:
             try:
@@ -56,7 +71,7 @@ def check_launch(mode: Mode = "strict") -> str | None:
             if process.popen is not None:
                 process.stop(grace=1.0)
             shutil.rmtree(process.workdir, ignore_errors=True)
-        expected = f"autograder-check-ok {student_uid(0)}"
+        expected = f"autograder-check-ok {student_uid(domain)}"
         if status == 0 and expected in process.output_text():
             return None
         return (f"the test program exited with status {status}: "

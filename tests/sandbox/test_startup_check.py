@@ -111,3 +111,16 @@ def test_where_isolation_works_the_check_passes_silently(mode, tmp_path):
     status, said = _result(_check(tmp_path, mode))
     assert (status, said) == (0, ""), said
     assert list((tmp_path / "tmp").iterdir()) == []
+
+
+@pytest.mark.skipif(not detect().strict, reason=f"needs strict isolation: {detect().reason}")
+def test_checks_at_once_leave_each_others_programs_running(tmp_path):
+    """Two graders that start at once each check isolation: the end of one check's program
+    (which sweeps every process of its user) must not end the other's, or that grader falls
+    to basic isolation and an unofficial grade. Each runs as the user of a domain it holds."""
+    def lingering(seconds: float) -> str:
+        return TEST_PROGRAM.replace("rclpy.shutdown()\n",
+                                    f"rclpy.shutdown()\nimport time\ntime.sleep({seconds})\n")
+
+    checks = [_check(tmp_path, "strict", lingering(seconds)) for seconds in (0.2, 2.0, 4.0)]
+    assert [_result(check) for check in checks] == [(0, "")] * 3
