@@ -17,6 +17,7 @@ from pathlib import Path
 
 import pytest
 
+from autograder.sandbox.domains import shared_lock_dir
 from autograder.sandbox.isolation import Isolation, detect, run_prefix
 from autograder.sandbox.privileged import PACKAGE_PARENT, SAFE_CWD, module_command
 from autograder.sandbox.startup_check import TEST_PROGRAM
@@ -49,6 +50,14 @@ def _check(tmp_path: Path, mode: str, program: str | None = None,
              **(env or {})})
 
 
+def _left(tmp_path: Path) -> list[Path]:
+    """What the check left in its temporary folder, but the domain lock folders, which
+    every run shares and keeps (``autograder.sandbox.domains.lock_dirs``)."""
+    shared = shared_lock_dir().name
+    return [p for p in (tmp_path / "tmp").iterdir()
+            if p.name != shared and not p.name.startswith(f"{shared}-")]
+
+
 def _result(check: subprocess.Popen[str]) -> tuple[int, str]:
     out, err = check.communicate(timeout=WALL)
     return check.returncode, out.strip() + err
@@ -60,7 +69,7 @@ def test_a_program_running_as_the_graders_own_user_fails_the_check(tmp_path):
     assert status == 1
     assert said.startswith("the test program exited with status 0: "
                            f"autograder-check-ok {os.getuid()}"), said
-    assert list((tmp_path / "tmp").iterdir()) == []  # its folders removed
+    assert _left(tmp_path) == []  # its folders removed
 
 
 def test_a_failing_program_is_named_with_its_status_and_last_lines(tmp_path):
@@ -69,7 +78,7 @@ def test_a_failing_program_is_named_with_its_status_and_last_lines(tmp_path):
     assert status == 1
     assert said.startswith("the test program exited with status 1: "), said
     assert "two" in said and "no middleware here" in said
-    assert list((tmp_path / "tmp").iterdir()) == []
+    assert _left(tmp_path) == []
 
 
 def test_a_launch_failure_is_named_by_its_stage(tmp_path):
@@ -78,7 +87,7 @@ def test_a_launch_failure_is_named_by_its_stage(tmp_path):
     assert status == 1
     assert said.startswith("the launcher failed at exec /nonexistent/python3: "
                            "FileNotFoundError"), said
-    assert list((tmp_path / "tmp").iterdir()) == []
+    assert _left(tmp_path) == []
 
 
 def test_stopped_it_stops_its_program_and_removes_its_folders(tmp_path):
@@ -95,7 +104,7 @@ def test_stopped_it_stops_its_program_and_removes_its_folders(tmp_path):
     status, said = _result(check)
     assert status != 0 and "KeyboardInterrupt" in said
     assert not Path(f"/proc/{started.read_text()}").exists()  # its program is gone
-    assert list((tmp_path / "tmp").iterdir()) == []
+    assert _left(tmp_path) == []
 
 
 @pytest.mark.skipif(not detect().strict, reason=f"needs strict isolation: {detect().reason}")
@@ -110,7 +119,7 @@ def test_where_isolation_works_the_check_passes_silently(mode, tmp_path):
     # The same check, its folders (the student's own included) under tmp_path: all removed.
     status, said = _result(_check(tmp_path, mode))
     assert (status, said) == (0, ""), said
-    assert list((tmp_path / "tmp").iterdir()) == []
+    assert _left(tmp_path) == []
 
 
 @pytest.mark.skipif(not detect().strict, reason=f"needs strict isolation: {detect().reason}")
