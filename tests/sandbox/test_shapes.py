@@ -303,7 +303,8 @@ def test_scratch_files_are_swept(shape_run):
 STALL = REPO / "tests" / "submissions" / "stalls" / "starves_the_world"
 
 
-@pytest.mark.parametrize("prefix", [(), SHAPES[0].prefix], ids=["strict", "container"])
+@pytest.mark.parametrize("prefix", [(), SHAPES[0].prefix, SHAPES[2].prefix],
+                         ids=["strict", "container", "ordinary-user"])
 def test_children_that_starve_the_world_fail_the_program_not_the_machine(prefix):
     """A silent node whose 100 spinning children starve the world (without a cgroup, in
     the container, every wait stalls): the program's zero, never "the machine was too
