@@ -69,14 +69,21 @@ def test_a_program_that_fails_at_once_is_the_programs_failure(tmp_path):
     assert "mine" in process.output_text()
 
 
-_FAMILY = """import os, sys, time
+# Two children, each with a child of its own; "forked" once all four are there (each
+# grandchild writes a byte when it runs, so its parent has forked it by then).
+_FAMILY = """import os, time
+ready, told = os.pipe()
 for _ in range(2):
-    if os.fork() == 0:  # a child, and its own child
+    if os.fork() == 0:
         if os.fork() == 0:
+            os.write(told, b"x")
             time.sleep(60)
             os._exit(0)
         time.sleep(60)
         os._exit(0)
+heard = b""
+while len(heard) < 2:
+    heard += os.read(ready, 2)
 print("forked", flush=True)
 time.sleep(60)
 """
