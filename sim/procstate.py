@@ -146,6 +146,36 @@ def runqueue_wait_ns(pid: int) -> int:
     return waited
 
 
+def child_pids(children: str) -> list[int]:
+    """The process ids a thread's ``children`` file lists (separated by spaces)."""
+    return [int(field) for field in children.split() if field.isdigit()]
+
+
+def descendants(pid: int, proc: str | os.PathLike[str] = "/proc") -> list[int]:
+    """Every process below ``pid`` (children, their children, ...), each once, as the
+    children files of every thread list them; empty if ``pid`` has ended."""
+    found: list[int] = []
+    seen = {pid}
+    todo = [pid]
+    while todo:
+        parent = todo.pop()
+        try:
+            threads = os.listdir(f"{proc}/{parent}/task")
+        except OSError:
+            continue
+        for thread in threads:
+            try:
+                text = _read_file(f"{proc}/{parent}/task/{thread}/children", 65536).decode()
+            except OSError:
+                continue
+            for child in child_pids(text):
+                if child not in seen:
+                    seen.add(child)
+                    found.append(child)
+                    todo.append(child)
+    return found
+
+
 ProcessKey = tuple[int, int]
 """(pid, start time in clock ticks): a pid taken again by a new process is another key."""
 

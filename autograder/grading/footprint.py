@@ -31,6 +31,8 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
+from sim.procstate import descendants
+
 PROC = Path("/proc")
 # Seconds between samples: a grading's memory changes as its processes start, slower than
 # that, and a sample's CPU (the kernel walks each process's page tables) must stay a small
@@ -56,11 +58,6 @@ def resident_kb(statm: str, page_kb: int) -> int | None:
     if len(fields) < 2 or not fields[1].isdigit():
         return None
     return int(fields[1]) * page_kb
-
-
-def child_pids(children: str) -> list[int]:
-    """The process ids a thread's ``children`` file lists (separated by spaces)."""
-    return [int(field) for field in children.split() if field.isdigit()]
 
 
 def _page_kb() -> int:
@@ -97,28 +94,6 @@ def process_kb(pid: int, proc: Path = PROC, page_kb: int | None = None) -> int:
         page_kb = _page_kb()
     found = resident_kb(text, page_kb) if text is not None else None
     return found or 0
-
-
-def descendants(pid: int, proc: Path = PROC) -> list[int]:
-    """Every process below ``pid`` (children, their children, ...), each once, as the
-    children files of every thread list them; empty if ``pid`` has ended."""
-    found: list[int] = []
-    seen = {pid}
-    todo = [pid]
-    while todo:
-        parent = todo.pop()
-        try:
-            threads = os.listdir(f"{proc}/{parent}/task")
-        except OSError:
-            continue
-        for thread in threads:
-            text = _read(f"{proc}/{parent}/task/{thread}/children")
-            for child in child_pids(text or ""):
-                if child not in seen:
-                    seen.add(child)
-                    found.append(child)
-                    todo.append(child)
-    return found
 
 
 def tree_kb(own: int, roots: Sequence[int], proc: Path = PROC,

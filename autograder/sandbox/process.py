@@ -33,6 +33,7 @@ from autograder.sandbox.cgroups import Cgroup
 from autograder.sandbox.contained import runner
 from autograder.sandbox.privileged import PACKAGE_PARENT, SAFE_CWD, module_command
 from autograder.sandbox.sweep import is_student_uid, sweep_user, user_processes
+from sim.procstate import descendants
 
 _PASS_THROUGH = (
     "PATH", "LD_LIBRARY_PATH", "PYTHONPATH", "AMENT_PREFIX_PATH", "ROS_DISTRO", "ROS_VERSION",
@@ -89,25 +90,6 @@ def student_process(script: Path, ros_args: list[str], limits: Limits, *, domain
         if isolation.strict:
             process.hide = protected_paths(course)
     return process
-
-
-def descendants(pid: int) -> set[int]:
-    """``pid`` and every live process below it (``/proc/<pid>/task/*/children``)."""
-    found, todo = set(), [pid]
-    while todo:
-        current = todo.pop()
-        if current in found:
-            continue
-        try:
-            tids = os.listdir(f"/proc/{current}/task")
-        except OSError:
-            continue
-        found.add(current)
-        for tid in tids:
-            with contextlib.suppress(OSError, ValueError):
-                with open(f"/proc/{current}/task/{tid}/children", "rb") as fh:
-                    todo.extend(int(child) for child in fh.read().split())
-    return found
 
 
 def student_python() -> str:
@@ -442,7 +424,7 @@ class StudentProcess:
             return self.cgroup.pids()
         if self.uid is not None and is_student_uid(self.uid):
             return set(user_processes(self.uid))
-        return descendants(self.pid)
+        return {self.pid, *descendants(self.pid)}
 
     def wait(self, timeout: float) -> int | None:
         """Wait (wall time) for the process to exit; its status, or None if it still runs."""

@@ -14,13 +14,12 @@ import pytest
 
 from autograder.grading.footprint import (
     Footprint,
-    child_pids,
-    descendants,
     process_kb,
     pss_kb,
     resident_kb,
     tree_kb,
 )
+from sim.procstate import child_pids, descendants
 
 ROLLUP = """\
 55d1c1e4f000-7ffd6a1b6000 ---p 00000000 00:00 0                          [rollup]
