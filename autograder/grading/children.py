@@ -253,8 +253,7 @@ def abandon(running: Sequence[Child], grace: float = 10.0) -> None:
             os.killpg(child.process.pid, signal.SIGKILL)
         with contextlib.suppress(subprocess.TimeoutExpired):
             child.process.wait(5.0)
-        for process in report.read(child.report_path, child.key).processes:
-            reap_recorded(process)
+        reap_recorded(report.read(child.report_path, child.key).processes)
         # A program the child was starting when it was killed has no record: where the
         # student has a user of its own, that user's sweep ends it all the same.
         if child.uid is not None:
@@ -267,8 +266,7 @@ def end(child: Child) -> Ended:
     raw = report.read(child.report_path, child.key, with_logs=True)
     with contextlib.suppress(ProcessLookupError, PermissionError):
         os.killpg(child.process.pid, signal.SIGKILL)
-    for process in raw.processes:
-        reap_recorded(process)
+    reap_recorded(raw.processes)
     log = child.log_path.read_text(errors="replace")
     if child.stopped:
         log += ("\nThe grading's pytest process was stopped from outside (SIGSTOP or a "

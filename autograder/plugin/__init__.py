@@ -114,8 +114,7 @@ def _watch_lifeline(fd: int, reporter: GradingReporter) -> None:
                 pass
         from autograder.sandbox.process import reap_recorded
 
-        for process in reporter.ending():
-            reap_recorded(process)
+        reap_recorded(reporter.ending())
         os.killpg(os.getpgrp(), signal.SIGKILL)
 
     threading.Thread(target=watch, daemon=True, name="autograder-lifeline").start()

@@ -23,7 +23,7 @@ import tempfile
 import threading
 import time
 import uuid
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
@@ -98,23 +98,27 @@ def student_python() -> str:
     return os.environ.get("AUTOGRADER_STUDENT_PYTHON") or sys.executable
 
 
-def reap_recorded(record: dict[str, Any]) -> None:
-    """Kill a student process known only by its record in the raw report (``pid`` and
-    ``cgroups``), from another process: its process group and everything in its cgroups;
-    then every process of its own user (``uid``, strict isolation), and remove its folder
-    (``workdir``, strict isolation), which the run that started it
-    removes when it stops the program, but not when the run itself is killed."""
-    with contextlib.suppress(ProcessLookupError, PermissionError):
-        os.killpg(record["pid"], signal.SIGKILL)
-    group = Cgroup.existing(record.get("cgroups", []))
-    group.kill_all()
-    group.remove()
-    uid = record.get("uid")
-    if isinstance(uid, int) and is_student_uid(uid):
+def reap_recorded(records: Iterable[dict[str, Any]]) -> None:
+    """Kill student processes known only by their records in the raw report (``pid`` and
+    ``cgroups``), from another process: each one's process group and everything in its
+    cgroups; then every process of each own user (``uid``, strict isolation), once a user
+    however many of its programs the run recorded (a sweep reads the scratch folders
+    whole), and remove their folders (``workdir``, strict isolation), which the run that
+    started them removes when it stops a program, but not when the run itself is killed."""
+    records = list(records)
+    for record in records:
+        with contextlib.suppress(ProcessLookupError, PermissionError):
+            os.killpg(record["pid"], signal.SIGKILL)
+        group = Cgroup.existing(record.get("cgroups", []))
+        group.kill_all()
+        group.remove()
+    users = {record.get("uid") for record in records}
+    for uid in sorted(u for u in users if isinstance(u, int) and is_student_uid(u)):
         sweep_user(uid)
-    workdir = record.get("workdir")
-    if isinstance(workdir, str) and is_strict_workdir(Path(workdir)):
-        shutil.rmtree(workdir, ignore_errors=True)
+    for record in records:
+        workdir = record.get("workdir")
+        if isinstance(workdir, str) and is_strict_workdir(Path(workdir)):
+            shutil.rmtree(workdir, ignore_errors=True)
 
 
 def is_strict_workdir(path: Path) -> bool:

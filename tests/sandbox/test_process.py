@@ -277,11 +277,27 @@ def test_reaping_a_record_removes_the_strict_folder_it_names_and_no_other(tmp_pa
     elsewhere.mkdir()
     other = Path(tempfile.mkdtemp(prefix="not-a-student-"))
     try:
-        for folder in (elsewhere, other, strict):
-            # pid 0 would signal our own group: a pid that is surely gone instead.
-            reap_recorded({"pid": 2 ** 22 + 1, "cgroups": [], "workdir": str(folder)})
+        # pid 0 would signal our own group: a pid that is surely gone instead.
+        reap_recorded([{"pid": 2 ** 22 + 1, "cgroups": [], "workdir": str(folder)}
+                       for folder in (elsewhere, other, strict)])
         assert not strict.exists()
         assert elsewhere.is_dir() and other.is_dir()
     finally:
         shutil.rmtree(strict, ignore_errors=True)
         shutil.rmtree(other, ignore_errors=True)
+
+
+def test_reaping_sweeps_each_user_once_however_many_of_its_programs(monkeypatch):
+    """A run records each program it started, often three of one student's user: reaping
+    them sweeps that user once (a sweep reads the scratch folders whole), and each user
+    of the records once."""
+    from autograder.sandbox import process
+    from autograder.sandbox.sweep import STUDENT_UID_BASE
+
+    swept: list[int] = []
+    monkeypatch.setattr(process, "sweep_user", swept.append)
+    gone = 2 ** 22 + 1  # a pid that is surely gone
+    reap_recorded([{"pid": gone, "cgroups": [], "uid": STUDENT_UID_BASE + 3}] * 3 +
+                  [{"pid": gone, "cgroups": [], "uid": STUDENT_UID_BASE + 4},
+                   {"pid": gone, "cgroups": [], "uid": 0}])
+    assert swept == [STUDENT_UID_BASE + 3, STUDENT_UID_BASE + 4]
