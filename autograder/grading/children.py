@@ -57,6 +57,25 @@ class Child:
     # The report's tests as last read, and the file's (inode, size, mtime) then.
     tests: list[RawTest] = dataclasses.field(default_factory=list)
     seen: tuple[int, int, int] | None = None
+    # The key pipe's write end while the key is held back (see :func:`started`).
+    key_pipe: int | None = None
+
+    def release(self) -> None:
+        """Send the child its key: until then it waits, having started pytest and the
+        plugin, before it collects a test or starts anything."""
+        if self.key_pipe is not None:
+            pipe, self.key_pipe = self.key_pipe, None
+            with os.fdopen(pipe, "wb") as out:
+                out.write(self.key)
+
+    def discard(self) -> None:
+        """End a child whose key was held back (it has started nothing), unreported."""
+        with contextlib.suppress(ProcessLookupError, PermissionError):
+            os.killpg(self.process.pid, signal.SIGKILL)
+        self.process.wait()
+        if self.key_pipe is not None:
+            os.close(self.key_pipe)
+            self.key_pipe = None
 
     def reported_tests(self) -> list[RawTest]:
         """The tests as the report says now, read again only when the file changed: it is
@@ -139,10 +158,11 @@ def pytest_env(env: dict[str, str]) -> dict[str, str]:
 @contextlib.contextmanager
 def started(prefix: Sequence[str], settings: RunSettings, targets: Sequence[str],
             folder: Path, rootdir: Path, lock: DomainLock, *,
-            zygote: bool = True) -> Iterator[Child]:
+            zygote: bool = True, hold_key: bool = False) -> Iterator[Child]:
     """Start one child pytest over ``targets`` (test folders or modules) in ``folder``;
     its lifeline closes when the block ends.  ``zygote``: whether it forks students'
-    programs from a zygote (see :func:`autograder.sandbox.process.warm_start`)."""
+    programs from a zygote (see :func:`autograder.sandbox.process.warm_start`).
+    ``hold_key``: its key is sent only at :meth:`Child.release` (it waits for it)."""
     folder.mkdir(parents=True, exist_ok=True)
     report_path = folder / "report.json"
     key = secrets.token_bytes(32)
@@ -159,6 +179,7 @@ def started(prefix: Sequence[str], settings: RunSettings, targets: Sequence[str]
     if not zygote:
         env["AUTOGRADER_ZYGOTE"] = "0"
     log_path = folder / "pytest.log"
+    child: Child | None = None
     try:
         with log_path.open("wb") as log:
             launched = time.monotonic()
@@ -168,11 +189,15 @@ def started(prefix: Sequence[str], settings: RunSettings, targets: Sequence[str]
                                        pass_fds=(key_read, life_read, *lock.fds))
         os.close(key_read)
         os.close(life_read)
-        with os.fdopen(key_write, "wb") as pipe:
-            pipe.write(key)
-        yield Child(process, report_path, key, log_path, launched,
-                    student_uid(lock.domain) if settings.own_user else None)
+        child = Child(process, report_path, key, log_path, launched,
+                      student_uid(lock.domain) if settings.own_user else None,
+                      key_pipe=key_write)
+        if not hold_key:
+            child.release()
+        yield child
     finally:
+        if child is not None and child.key_pipe is not None:  # never released: it ends
+            child.discard()
         os.close(life_write)
 
 

@@ -49,9 +49,11 @@ from autograder.grading.module_groups import (
 from autograder.i18n import _, get_language
 from autograder.sandbox.domains import DomainLock, NoDomain, bound_on_domains, hold_domain
 from autograder.sandbox.isolation import (
+    Detection,
     Isolation,
     close_to_others,
     detect,
+    detection,
     protected_paths,
     run_prefix,
     student_uid,
@@ -118,9 +120,7 @@ def _grade_once(exercise: Exercise, submission: Path | None, *, hidden: bool,
     refusal = _refusal(exercise, submission)
     if refusal is not None:  # nothing to run: no world, no domain, no child
         return _refused(exercise, refusal, time.monotonic() - started)
-    isolation = detect()
-    if isolation.mode == "user":  # no mount namespace hides them: permissions must
-        close_to_others(protected_paths(exercise.folder.parent.parent))
+    detecting = detection()  # its check runs while the children start
     record, warnings = record_folder(record)
     plan = _Plan.of(exercise, hidden)
     wanted = 1 if domain is not None else children_for(module_jobs, len(plan.modules),
@@ -129,9 +129,9 @@ def _grade_once(exercise: Exercise, submission: Path | None, *, hidden: bool,
         with contextlib.ExitStack() as stack:
             locks = [stack.enter_context(hold_domain(domain))]
             locks += _more_domains(stack, wanted - 1)
-            result, raw = _run(exercise, submission, plan, locks, isolation,
-                               real_time_factor, Watchers(progress, running), started,
-                               record)
+            result, raw, isolation = _run(exercise, submission, plan, locks, detecting,
+                                          real_time_factor, Watchers(progress, running),
+                                          started, record)
     except NoDomain as exc:
         return _fault(exercise, str(exc), time.monotonic() - started)
     if warnings:
@@ -222,38 +222,51 @@ def _shown_name(exercise: Exercise, submission: Path | None) -> str:
 
 
 def _run(exercise: Exercise, submission: Path | None, plan: _Plan,
-         locks: Sequence[DomainLock], isolation: Isolation, real_time_factor: float | None,
+         locks: Sequence[DomainLock], detecting: Detection, real_time_factor: float | None,
          watchers: Watchers, started: float, record: Path | None = None,
-         ) -> tuple[RunResult, RawReport]:
-    """One grading in child pytests, one per reserved domain; the result and the merged
-    raw report. Each child gets its :class:`~autograder.core.settings.RunSettings` as one
-    document (see :mod:`autograder.grading.children`). Every child forks students'
-    programs from a zygote of its own (in its own namespaces), so each start after the
-    first is a fork, not an exec (docs/contributors/design.md, "Warm starts")."""
+         ) -> tuple[RunResult, RawReport, Isolation]:
+    """One grading in child pytests, one per reserved domain; the result, the merged raw
+    report and the isolation it ran in. Each child gets its
+    :class:`~autograder.core.settings.RunSettings` as one document (see
+    :mod:`autograder.grading.children`). Every child forks students' programs from a
+    zygote of its own (in its own namespaces), so each start after the first is a fork,
+    not an exec (docs/contributors/design.md, "Warm starts").
+
+    The children start in the isolation the machine likely allows while its start-up
+    check runs (``detecting``), and wait for their keys: they grade once the check has
+    confirmed it, and are ended unused and started again in the isolation it found if it
+    did not. So the check and the children's start share the wall time."""
     targets = plan.targets(len(locks))
-    settings = RunSettings(
-        domains=tuple(lock.domain for lock in locks),
-        exercise=str(exercise.folder),
-        submission=str(Path(submission).resolve()) if submission is not None else None,
-        course=str(exercise.folder.parent.parent), real_time_factor=real_time_factor,
-        isolation=isolation.mode, lang=get_language(),
-        record=str(record) if record is not None else None,
-        submission_name=_shown_name(exercise, submission))
+    isolation = detecting.likely
     # A program left running where nothing ends it (basic isolation without a cgroup) may
     # still write here as it goes: what it keeps is left, never the grader's crash.
     with tempfile.TemporaryDirectory(prefix="autograder-", ignore_cleanup_errors=True) as tmp:
         running: list[children.Child] = []
         try:
-            with contextlib.ExitStack() as lifelines:
-                for index, (group, lock) in enumerate(zip(targets, locks, strict=False)):
-                    count_only = tuple(str(f) for f in plan.count_only if f in group)
-                    running.append(lifelines.enter_context(children.started(
-                        run_prefix(isolation),
-                        dataclasses.replace(settings, count_only=count_only),
-                        [str(t) for t in group], Path(tmp) / f"child-{index}",
-                        exercise.folder, lock)))
-                footprint = Footprint([child.process.pid for child in running])
-                children.wait(running, exercise.time_limit, watchers, footprint)
+            while True:
+                settings = _settings(exercise, submission, locks, isolation,
+                                     real_time_factor, record)
+                with contextlib.ExitStack() as lifelines:
+                    running = []
+                    for index, (group, lock) in enumerate(zip(targets, locks, strict=False)):
+                        count_only = tuple(str(f) for f in plan.count_only if f in group)
+                        running.append(lifelines.enter_context(children.started(
+                            run_prefix(isolation),
+                            dataclasses.replace(settings, count_only=count_only),
+                            [str(t) for t in group], Path(tmp) / f"child-{index}",
+                            exercise.folder, lock, hold_key=True)))
+                    confirmed = detecting.result()
+                    if confirmed.mode != isolation.mode:
+                        isolation = confirmed
+                        continue  # leaving the block ends the children, keys unsent
+                    isolation = confirmed
+                    if isolation.mode == "user":  # no mount namespace hides them
+                        close_to_others(protected_paths(exercise.folder.parent.parent))
+                    for child in running:
+                        child.release()
+                    footprint = Footprint([child.process.pid for child in running])
+                    children.wait(running, exercise.time_limit, watchers, footprint)
+                break
         except BaseException:  # stopped (a signal, Ctrl-C): the children go before tmp
             children.abandon(running)
             raise
@@ -263,7 +276,22 @@ def _run(exercise: Exercise, submission: Path | None, plan: _Plan,
     result = verdict(exercise, raw, ended, elapsed, all_tests=plan.all_tests)
     timing = _timing(raw.data, min(e.launched for e in ended), elapsed, len(ended))
     memory = MemoryUse.of(raw.data.get("memory"), footprint.peak_mb)
-    return dataclasses.replace(result, timing=timing, memory=memory), raw
+    return dataclasses.replace(result, timing=timing, memory=memory), raw, isolation
+
+
+def _settings(exercise: Exercise, submission: Path | None, locks: Sequence[DomainLock],
+              isolation: Isolation, real_time_factor: float | None,
+              record: Path | None) -> RunSettings:
+    """The settings every child of a grading shares (each then gets its own report, key,
+    lifeline and domain)."""
+    return RunSettings(
+        domains=tuple(lock.domain for lock in locks),
+        exercise=str(exercise.folder),
+        submission=str(Path(submission).resolve()) if submission is not None else None,
+        course=str(exercise.folder.parent.parent), real_time_factor=real_time_factor,
+        isolation=isolation.mode, lang=get_language(),
+        record=str(record) if record is not None else None,
+        submission_name=_shown_name(exercise, submission))
 
 
 def _timing(data: dict[str, Any], launched: float, elapsed: float,

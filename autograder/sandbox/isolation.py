@@ -30,10 +30,10 @@ user and can read, stop and change what the grader can: its results are not offi
 from __future__ import annotations
 
 import dataclasses
-import functools
 import os
 import shutil
 import subprocess
+import threading
 from pathlib import Path
 from typing import Literal
 
@@ -80,40 +80,109 @@ def student_uid(domain: int) -> int:
     return STUDENT_UID_BASE + domain
 
 
-@functools.cache
-def detect() -> Isolation:
-    """Strict isolation if we are root, namespaces work, and a test program started the
-    way every student's program is (:func:`autograder.sandbox.process.student_process`, in the
+class Detection:
+    """This machine's isolation being found out: the mode to try (``likely``) is known at
+    once, the start-up check that confirms it runs meanwhile, and :meth:`result` waits for
+    its answer. A grading starts its children in the likely mode while the check runs, and
+    lets them grade only once it has confirmed it (:func:`autograder.grading.run.grade`).
+
+    Strict isolation if we are root, namespaces work, and a test program started the way
+    every student's program is (:func:`autograder.sandbox.process.student_process`, in the
     run's namespaces) runs Python and rclpy as a user of its own: if the check passes,
-    launches work; if not, basic isolation is used and the reason is kept."""
-    asked = os.environ.get("AUTOGRADER_ISOLATION")
-    if asked == "basic":
-        return Isolation("basic", N_("basic isolation was asked for (AUTOGRADER_ISOLATION)"))
-    if os.geteuid() != 0:
-        return Isolation("basic", N_("the grader does not run as root"))
-    if asked == "user":
-        strict = Isolation("user", N_("isolation by user was asked for "
-                                      "(AUTOGRADER_ISOLATION)"))
-    elif shutil.which("unshare") is None:
-        strict = Isolation("user", N_("the unshare command (util-linux) is missing"))
-    else:
-        strict = _check(Isolation("strict"))
-        if strict.mode == "strict":
-            return strict
-    # No namespaces: a user of its own all the same, if a test program runs as one.
-    own = _check(Isolation("user", strict.reason, strict.detail))
+    launches work; if not, isolation by user if a test program runs as a user of its own
+    without namespaces, else basic isolation, and the reason is kept."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._result: Isolation | None = None
+        self._running: subprocess.Popen[str] | None = None
+        asked = os.environ.get("AUTOGRADER_ISOLATION")
+        if asked == "basic":
+            self._result = Isolation(
+                "basic", N_("basic isolation was asked for (AUTOGRADER_ISOLATION)"))
+        elif os.geteuid() != 0:
+            self._result = Isolation("basic", N_("the grader does not run as root"))
+        elif asked == "user":
+            self.likely = Isolation("user", N_("isolation by user was asked for "
+                                               "(AUTOGRADER_ISOLATION)"))
+        elif shutil.which("unshare") is None:
+            self.likely = Isolation("user", N_("the unshare command (util-linux) is missing"))
+        else:
+            self.likely = Isolation("strict")
+        if self._result is not None:
+            self.likely = self._result
+        else:
+            self._running = _start_check(self.likely)
+
+    def result(self) -> Isolation:
+        """The isolation the check confirmed (waiting for it), the same at every call."""
+        with self._lock:
+            if self._result is None:
+                assert self._running is not None
+                first = _check_answer(self.likely, self._running)
+                self._result = first
+                if first.mode != self.likely.mode:
+                    self._result = _without_namespaces(self.likely, first)
+            return self._result
+
+
+def _without_namespaces(tried: Isolation, failed: Isolation) -> Isolation:
+    """What is left when the check of ``tried`` ``failed``: after strict, a user of its own
+    if a test program runs as one without namespaces; else basic, with every reason."""
+    if not tried.strict:
+        return failed
+    own = _check(Isolation("user", failed.reason, failed.detail))
     if own.mode == "user":
         return own
-    return Isolation("basic", own.reason, " / ".join(d for d in (strict.detail, own.detail)
+    return Isolation("basic", own.reason, " / ".join(d for d in (failed.detail, own.detail)
                                                       if d))
+
+
+_detection: Detection | None = None
+_detection_lock = threading.Lock()
+
+
+def detection() -> Detection:
+    """This process's :class:`Detection`, begun at the first call (a batch's gradings, in
+    threads of one process, share it)."""
+    global _detection
+    with _detection_lock:
+        if _detection is None:
+            _detection = Detection()
+        return _detection
+
+
+def detect() -> Isolation:
+    """This machine's isolation (see :class:`Detection`), waiting for the check."""
+    return detection().result()
+
+
+def forget() -> None:
+    """Find the isolation afresh at the next call (tests that set AUTOGRADER_ISOLATION);
+    a check under way is waited for first, so that none is left running."""
+    global _detection
+    with _detection_lock:
+        old, _detection = _detection, None
+    if old is not None:
+        old.result()
 
 
 def _check(isolation: Isolation) -> Isolation:
     """``isolation`` if a test program runs in it as a student's does; else basic, why."""
+    return _check_answer(isolation, _start_check(isolation))
+
+
+def _start_check(isolation: Isolation) -> subprocess.Popen[str]:
+    """The start-up check of ``isolation``, started."""
     command = [*run_prefix(isolation),
                *module_command("autograder.sandbox.startup_check", [isolation.mode])]
-    with subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                          text=True, cwd=SAFE_CWD) as running:
+    return subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, cwd=SAFE_CWD)
+
+
+def _check_answer(isolation: Isolation, running: subprocess.Popen[str]) -> Isolation:
+    """What the start-up check of ``isolation`` answered: ``isolation`` if it passed."""
+    with running:
         try:
             out, err = running.communicate(timeout=120)
         except BaseException as exc:  # stopped, or no answer: it cleans up on SIGTERM
@@ -125,6 +194,7 @@ def _check(isolation: Isolation) -> Isolation:
             if isinstance(exc, subprocess.TimeoutExpired):
                 return Isolation("basic", _could_not(isolation), "no answer within 120 s")
             raise
+    command = running.args
     checked = subprocess.CompletedProcess(command, running.returncode, out, err)
     if checked.returncode == 0:
         return isolation

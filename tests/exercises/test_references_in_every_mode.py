@@ -29,14 +29,14 @@ pytestmark = [pytest.mark.slow,
 def mode(request: pytest.FixtureRequest) -> Iterator[str]:
     old = os.environ.get("AUTOGRADER_ISOLATION")
     os.environ["AUTOGRADER_ISOLATION"] = request.param
-    isolation.detect.cache_clear()
+    isolation.forget()
     with modes_kept(isolation.protected_paths(course_root())):
         yield request.param
     if old is None:
         os.environ.pop("AUTOGRADER_ISOLATION", None)
     else:
         os.environ["AUTOGRADER_ISOLATION"] = old
-    isolation.detect.cache_clear()
+    isolation.forget()
 
 
 def _known_bad(exercise: Exercise) -> Variant:

@@ -130,3 +130,40 @@ def test_an_ordinary_users_grading_resists_a_program_that_stops_it(tmp_path):
     assert "MEM OPENED" not in log and "MEM DENIED" in log
     assert done.returncode == 3, output[-3000:]
     assert "this grade is not official" in output  # the student's sentence
+
+
+def test_what_is_known_without_a_check_is_known_at_once(monkeypatch):
+    """Basic isolation asked for (or an ordinary user): no start-up check runs, and the
+    likely isolation is the answer."""
+    from autograder.sandbox import isolation
+
+    started: list[Isolation] = []
+    monkeypatch.setattr(isolation, "_start_check", started.append)
+    monkeypatch.setenv("AUTOGRADER_ISOLATION", "basic")
+    detecting = isolation.Detection()
+    assert detecting.likely == detecting.result() == Isolation(
+        "basic", "basic isolation was asked for (AUTOGRADER_ISOLATION)")
+    assert started == []
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="the start-up check runs only for root")
+def test_a_check_that_fails_falls_back_with_every_reason(monkeypatch):
+    """Strict likely, its check refused: a user of its own is checked next, and where that
+    fails too the answer is basic, naming both checks' details."""
+    from autograder.sandbox import isolation
+
+    def fake_check(tried: Isolation) -> subprocess.Popen[str]:
+        code = f"import sys; print('no {tried.mode} here'); sys.exit(1)"
+        return subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE,
+                                stderr=subprocess.PIPE, text=True)
+
+    monkeypatch.delenv("AUTOGRADER_ISOLATION", raising=False)
+    monkeypatch.setattr(isolation, "_start_check", fake_check)
+    monkeypatch.setattr(isolation.shutil, "which", lambda name: f"/usr/bin/{name}")
+    detecting = isolation.Detection()
+    assert detecting.likely == Isolation("strict")
+    found = detecting.result()
+    assert found.mode == "basic"
+    assert found.reason == "a test program could not run as a user of its own"
+    assert found.detail == "no strict here / no user here"
+    assert detecting.result() is found  # asked again: the same answer, no new check

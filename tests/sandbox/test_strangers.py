@@ -44,10 +44,10 @@ def shout(monkeypatch: pytest.MonkeyPatch):
     monkeypatch.setenv("AUTOGRADER_ISOLATION", "user")
     from autograder.sandbox import isolation
 
-    isolation.detect.cache_clear()
+    isolation.forget()
     with modes_kept(isolation.protected_paths(COURSE)):
         yield find_exercise("shout")
-    isolation.detect.cache_clear()
+    isolation.forget()
 
 
 def _participant(domain: int, code: str, uid: int | None = None,
