@@ -333,6 +333,10 @@ class SimBridge:
         """Subscriptions our /clock publisher has matched (the probe's among them)."""
         return self._clock_pub.get_subscription_count()
 
+    def scan_listeners(self) -> int:
+        """Subscriptions our /scan publisher has matched."""
+        return self._scan_pub.get_subscription_count()
+
     def wait_until(self, sim_time: float, wall_timeout: float) -> bool:
         """Block until sim time reaches ``sim_time``; False if ``wall_timeout`` passes first.
         A gated world's first wait opens its gate."""
