@@ -26,6 +26,7 @@ parametrizes ``correct`` and ``known_bad`` from the folders.
     python tests/proving.py losses EXERCISE    # grade everything, print what each lost
                                                # and what each lost test said
     python tests/proving.py patch FOLDER       # turn a full copy into FILE.patch
+    python tests/proving.py sim-seconds EXERCISE  # each test's simulation seconds
 """
 
 from __future__ import annotations
@@ -37,6 +38,7 @@ import functools
 import json
 import os
 import re
+import statistics
 import sys
 import tempfile
 from concurrent.futures import ThreadPoolExecutor
@@ -45,9 +47,11 @@ from typing import Any
 
 import yaml
 
+from autograder.commands.exercise_checks import WALL_TIME, simulation_seconds
 from autograder.core.exercise import Exercise, find_exercise
 from autograder.core.results import RunResult
 from autograder.grading.run import grade
+from content.course import course_root
 
 SUBMISSIONS = Path(__file__).parent / "submissions"
 # Gradings at a time: two, as `grade-batch --jobs 2` on this 2-core machine (three made the
@@ -436,6 +440,41 @@ def test_each_hint_is_given_once(graded: dict[str, RunResult]) -> None:
     assert not repeated
 
 
+def references_simulation_seconds(graded: dict[str, RunResult]) -> dict[str, float]:
+    """Each test's simulation seconds to its verdict (setup and call: a module's shared run
+    counts in its first test), the median over the reference's gradings."""
+    runs: dict[str, list[float]] = {}
+    for name, result in graded.items():
+        if name.startswith("reference#") and result.timing is not None:
+            for nodeid, seconds in result.timing.sim_seconds.items():
+                runs.setdefault(nodeid.rpartition("::")[2], []).append(seconds)
+    return {test: statistics.median(values) for test, values in runs.items()}
+
+
+# A test's simulation seconds move by a tick or a few with when the node reacts: the README
+# gives them to a tenth, and they hold within this much (seconds, or a fraction of them).
+SIM_SECONDS_SLACK = (1.0, 0.15)
+
+
+def test_readme_gives_each_tests_simulation_seconds(graded: dict[str, RunResult],
+                                                     proof: Proof) -> None:
+    """Each README's grading table gives the simulation seconds each test takes to its
+    verdict, as the reference's gradings measure them: what a grading's wall time
+    approaches at the exercise's pace (issue 36, "know the floor")."""
+    exercise = find_exercise(proof.exercise)
+    measured = references_simulation_seconds(graded)
+    wrong = {}
+    for readme, given in simulation_seconds(exercise, course_root()).items():
+        for test, seconds in given.items():
+            real = measured.get(test)
+            if real is None or seconds == WALL_TIME:  # its exit, timed on the wall clock
+                continue
+            slack = max(SIM_SECONDS_SLACK[0], SIM_SECONDS_SLACK[1] * real)
+            if not isinstance(seconds, float) or abs(seconds - real) > slack:
+                wrong[f"{readme}: {test}"] = {"README": seconds, "measured": round(real, 1)}
+    assert not wrong, explain(**wrong)
+
+
 # What every exercise's proof checks: tests/conftest.py adds these to each module that
 # declares PROOF, parametrized from its submission folders (``correct``, ``known_bad``).
 STANDARD_CHECKS = (test_reference_scores_full_marks_every_time,
@@ -444,7 +483,8 @@ STANDARD_CHECKS = (test_reference_scores_full_marks_every_time,
                    test_known_bad_variant_loses_exactly_the_tests_aimed_at_it,
                    test_known_bad_variant_passes_only_with_every_core_test,
                    test_known_bad_variant_is_told_what_was_observed,
-                   test_each_hint_is_given_once)
+                   test_each_hint_is_given_once,
+                   test_readme_gives_each_tests_simulation_seconds)
 
 
 # -- tools -----------------------------------------------------------------------------------
@@ -486,9 +526,20 @@ def _patch(folder: Path) -> None:
     print(f"{copy}: {len(variant.splitlines())} lines -> patch of {len(patch.splitlines())}")
 
 
+def _sim_seconds(exercise_id: str) -> None:
+    """Grade the reference three times and print each test's simulation seconds (the
+    median), for the READMEs' grading tables."""
+    exercise = find_exercise(exercise_id)
+    graded = {f"reference#{i}": grade(exercise, None) for i in range(3)}
+    for test, seconds in references_simulation_seconds(graded).items():
+        print(f"{test}: {seconds:.1f}")
+
+
 def main(argv: list[str]) -> int:
     if len(argv) == 2 and argv[0] == "losses":
         _losses(argv[1])
+    elif len(argv) == 2 and argv[0] == "sim-seconds":
+        _sim_seconds(argv[1])
     elif len(argv) >= 2 and argv[0] == "patch":
         for folder in argv[1:]:
             _patch(Path(folder))

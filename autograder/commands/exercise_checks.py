@@ -23,6 +23,9 @@ from autograder.i18n.tools import Problem
 # Each README, in its language: the heading of the section on running the node by hand.
 READMES = {"README.md": ("en", "### Trying your node by hand", "**core**"),
            "README.ur.md": ("ur", "### اپنے نوڈ کو ہاتھ سے آزمانا", "**بنیادی**")}
+# A grading table's simulation seconds for a test timed on the wall clock (a process's
+# exit), in every README's language: the words the Urdu READMEs use too.
+WALL_TIME = "wall time"
 _RUN = re.compile(r"autograder sim run --world (\S+) --node (\S+)")
 _TEST_WORLD = re.compile(r'mark\.world\("([\w.]+)"\)|^WORLD = "([\w.]+)"', re.M)
 
@@ -152,24 +155,40 @@ def _translator(root: Path, lang: str) -> Callable[[str], str]:
     return gettext
 
 
-def _table(exercise: Exercise, tests: list[GradedTest], path: Path, lines: list[str],
-           core_mark: str, gettext: Callable[[str], str]) -> list[Problem]:
-    """The grading table (headed ``| test |``) is each test's label in the README's
-    language, its points, public or hidden, and its core mark; one row per test."""
+def _rows(lines: list[str]) -> tuple[int | None, dict[str, tuple[int, tuple[str, ...]]]]:
+    """The grading table (headed ``| test |``): the line it starts on, and its rows by
+    label (backticks dropped): each row's line number and its other cells."""
     start = next((n for n, line in enumerate(lines) if line.startswith("| test |")), None)
-    if start is None:
-        return [Problem(path, None, _(
-            "no grading table: a table headed `| test |` with a row per test (its label, "
-            "points, public or hidden, core)"))]
     rows: dict[str, tuple[int, tuple[str, ...]]] = {}
+    if start is None:
+        return None, rows
     for n in range(start + 2, len(lines)):
         if not lines[n].startswith("|"):
             break
         cells = tuple(c.strip() for c in lines[n].strip().strip("|").split("|"))
         rows[cells[0].replace("`", "")] = (n + 1, cells[1:])
+    return start, rows
+
+
+def _label(test: GradedTest, gettext: Callable[[str], str]) -> str:
+    return gettext(test.label).replace("`", "") if test.label else test.name
+
+
+def _table(exercise: Exercise, tests: list[GradedTest], path: Path, lines: list[str],
+           core_mark: str, gettext: Callable[[str], str]) -> list[Problem]:
+    """The grading table (headed ``| test |``) is each test's label in the README's
+    language, its points, public or hidden, and its core mark; one row per test. A fifth
+    column, if the table has one, gives the simulation seconds the test takes to its
+    verdict (the exercise's proofs hold it to the reference's gradings), or ``wall time``
+    for one timed on the wall clock."""
+    start, rows = _rows(lines)
+    if start is None:
+        return [Problem(path, None, _(
+            "no grading table: a table headed `| test |` with a row per test (its label, "
+            "points, public or hidden, core)"))]
     problems = []
     for test in tests:
-        label = gettext(test.label).replace("`", "") if test.label else test.name
+        label = _label(test, gettext)
         wanted = (str(test.points), test.visibility,
                   core_mark if test.name in exercise.core else "")
         line, cells = rows.pop(label, (None, None))
@@ -177,14 +196,44 @@ def _table(exercise: Exercise, tests: list[GradedTest], path: Path, lines: list[
             problems.append(Problem(path, start + 1, _(
                 "the grading table has no row for {test} ({label!r})").format(
                 test=test.name, label=label)))
-        elif cells != wanted:
+        elif cells[:3] != wanted:
             problems.append(Problem(path, line, _(
                 "the row of {test} says {found}; its test says {wanted}").format(
-                test=test.name, found=" | ".join(cells), wanted=" | ".join(wanted))))
+                test=test.name, found=" | ".join(cells[:3]), wanted=" | ".join(wanted))))
+        elif len(cells) > 3 and not _seconds(cells[3]) and cells[3] != WALL_TIME:
+            problems.append(Problem(path, line, _(
+                "the row of {test} gives {found!r} as its simulation seconds: a number, "
+                "such as 2.5, or {wall!r} for a test timed on the wall clock").format(
+                test=test.name, found=cells[3], wall=WALL_TIME)))
     for label, (line, _cells) in rows.items():
         problems.append(Problem(path, line, _(
             "the grading table's row {label!r} is no test's label").format(label=label)))
     return problems
+
+
+def _seconds(cell: str) -> bool:
+    return re.fullmatch(r"\d+(\.\d+)?", cell) is not None
+
+
+def simulation_seconds(exercise: Exercise,
+                       root: Path) -> dict[str, dict[str, float | str | None]]:
+    """What each README's grading table gives as each test's simulation seconds, by README
+    and test name: a number, :data:`WALL_TIME`, or None (no such cell, or neither)."""
+    tests = graded_tests(exercise)
+    given: dict[str, dict[str, float | str | None]] = {}
+    for name, (lang, _heading, _core) in READMES.items():
+        path = exercise.folder / name
+        if not path.exists():
+            continue
+        gettext = _translator(root, lang)
+        _start, rows = _rows(path.read_text(encoding="utf-8").splitlines())
+        given[name] = {}
+        for test in tests:
+            cells = rows.get(_label(test, gettext), (0, ()))[1]
+            seconds = cells[3] if len(cells) > 3 else ""
+            given[name][test.name] = float(seconds) if _seconds(seconds) else (
+                WALL_TIME if seconds == WALL_TIME else None)
+    return given
 
 
 def _translated(exercise: Exercise, root: Path) -> list[Problem]:

@@ -81,6 +81,26 @@ def test_each_row_of_the_grading_table_is_a_test_as_graded(course: Path) -> None
     assert any("row 'Each message is answered twice' is no test's label" in p for p in found)
 
 
+def test_a_tables_simulation_seconds_are_a_number_or_wall_time(course: Path) -> None:
+    """A fifth column gives each test's simulation seconds (the proofs hold them to the
+    reference's gradings), or "wall time" for a test timed on the wall clock."""
+    path = readme(course)
+    text = path.read_text()
+    for row, cell in (("| test | points | visibility | core |", " simulation s |"),
+                      ("|---|---|---|---|", "---|"),
+                      ("| The node starts and publishes on shout | 1 | public |  |", " 2.5 |"),
+                      ("| What it hears comes out upper-cased | 1 | public | **core** |",
+                       " wall time |"),
+                      ("| Each message is answered exactly once | 1 | hidden |  |", " soon |")):
+        assert row in text
+        text = text.replace(row, row + cell)
+    path.write_text(text)
+    line = line_of(path, "answered exactly once")
+    assert [p for p in problems(course) if "simulation seconds" in p] == [
+        f"{path}:{line}: the row of test_once_per_message gives 'soon' as its simulation "
+        "seconds: a number, such as 2.5, or 'wall time' for a test timed on the wall clock"]
+
+
 def test_two_test_modules_of_one_name_are_named(course: Path) -> None:
     tests = course / "assignments" / "shout" / "tests"
     shutil.copy(tests / "hidden" / "test_once.py", tests / "public" / "test_once.py")
