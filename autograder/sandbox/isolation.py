@@ -112,7 +112,7 @@ class Detection:
         if self._result is not None:
             self.likely = self._result
         else:
-            self._running = _start_check(self.likely)
+            self._running = start_check(self.likely)
 
     def result(self) -> Isolation:
         """The isolation the check confirmed (waiting for it), the same at every call."""
@@ -169,10 +169,10 @@ def forget() -> None:
 
 def _check(isolation: Isolation) -> Isolation:
     """``isolation`` if a test program runs in it as a student's does; else basic, why."""
-    return _check_answer(isolation, _start_check(isolation))
+    return _check_answer(isolation, start_check(isolation))
 
 
-def _start_check(isolation: Isolation) -> subprocess.Popen[str]:
+def start_check(isolation: Isolation) -> subprocess.Popen[str]:
     """The start-up check of ``isolation``, started."""
     command = [*run_prefix(isolation),
                *module_command("autograder.sandbox.startup_check", [isolation.mode])]

@@ -138,7 +138,7 @@ def test_what_is_known_without_a_check_is_known_at_once(monkeypatch):
     from autograder.sandbox import isolation
 
     started: list[Isolation] = []
-    monkeypatch.setattr(isolation, "_start_check", started.append)
+    monkeypatch.setattr(isolation, "start_check", started.append)
     monkeypatch.setenv("AUTOGRADER_ISOLATION", "basic")
     detecting = isolation.Detection()
     assert detecting.likely == detecting.result() == Isolation(
@@ -158,7 +158,7 @@ def test_a_check_that_fails_falls_back_with_every_reason(monkeypatch):
                                 stderr=subprocess.PIPE, text=True)
 
     monkeypatch.delenv("AUTOGRADER_ISOLATION", raising=False)
-    monkeypatch.setattr(isolation, "_start_check", fake_check)
+    monkeypatch.setattr(isolation, "start_check", fake_check)
     monkeypatch.setattr(isolation.shutil, "which", lambda name: f"/usr/bin/{name}")
     detecting = isolation.Detection()
     assert detecting.likely == Isolation("strict")
