@@ -55,9 +55,16 @@ class DomainLock:
     fds: tuple[int, ...]
 
 
+# The shared lock folder unless AUTOGRADER_LOCK_DIR says otherwise: a fixed path, not under
+# $TMPDIR, which differs between users and jobs (pam_tmpdir, CI runners, a test's own). Two
+# graders with different folders would take the same domain, and in strict isolation no
+# bound port shows the other (each run has its network namespace): one's sweep of the
+# domain's student user would then kill the other's student.
+DEFAULT_LOCK_DIR = Path("/tmp/autograder-domains")
+
+
 def shared_lock_dir() -> Path:
-    return Path(os.environ.get("AUTOGRADER_LOCK_DIR",
-                               Path(tempfile.gettempdir()) / "autograder-domains"))
+    return Path(os.environ.get("AUTOGRADER_LOCK_DIR", DEFAULT_LOCK_DIR))
 
 
 def _usable_shared(folder: Path) -> bool:

@@ -201,3 +201,19 @@ def test_a_lock_an_ordinary_users_run_holds_is_respected_by_root(lock_dir):
         _let_go(holder)
     with hold_domain(free) as lock:
         assert lock.domain == free
+
+
+def test_the_shared_lock_folder_does_not_follow_tmpdir(monkeypatch, tmp_path):
+    """Graders whose $TMPDIR differs (users, CI jobs, a test's own) lock in one folder: in
+    strict isolation no bound port shows another run's domain, so a second folder would
+    let two runs take the same domain and one's sweep of its student user end the other's."""
+    from autograder.sandbox.domains import DEFAULT_LOCK_DIR, lock_dirs, shared_lock_dir
+
+    monkeypatch.delenv("AUTOGRADER_LOCK_DIR", raising=False)
+    monkeypatch.setenv("TMPDIR", str(tmp_path))
+    tempfile.tempdir = None  # read $TMPDIR again, as a process started with it would
+    try:
+        assert shared_lock_dir() == DEFAULT_LOCK_DIR == Path("/tmp/autograder-domains")
+        assert not str(lock_dirs()[0]).startswith(str(tmp_path))
+    finally:
+        tempfile.tempdir = None
