@@ -53,7 +53,6 @@ from autograder.sandbox.isolation import (
     close_to_others,
     detect,
     protected_paths,
-    run_prefix,
     student_uid,
 )
 from sim.recorder import Recording
@@ -248,11 +247,12 @@ def _run(exercise: Exercise, submission: Path | None, plan: _Plan,
                 for index, (group, lock) in enumerate(zip(targets, locks, strict=False)):
                     count_only = tuple(str(f) for f in plan.count_only if f in group)
                     running.append(lifelines.enter_context(children.started(
-                        run_prefix(isolation),
+                        isolation,
                         dataclasses.replace(settings, count_only=count_only),
                         [str(t) for t in group], Path(tmp) / f"child-{index}",
                         exercise.folder, lock)))
-                footprint = Footprint([child.process.pid for child in running])
+                footprint = Footprint([child.process.pid for child in running],
+                                      alone=children.forked_from(running))
                 children.wait(running, exercise.time_limit, watchers, footprint)
         except BaseException:  # stopped (a signal, Ctrl-C): the children go before tmp
             children.abandon(running)
