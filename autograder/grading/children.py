@@ -6,7 +6,7 @@ The child inherits its domain's lock (it holds the domain as long as it lives) a
 read end of a *lifeline* pipe whose write end only the grader holds: when the grader
 dies, however it dies, the child sees the pipe close and ends itself and every student
 process it started (see ``autograder.plugin``).  It is forked from this process's
-template where there is one (:mod:`autograder.grading.template`), else exec'd as
+template where there is one (:mod:`autograder.grading.forked`), else exec'd as
 ``python -m pytest``: the same child either way.
 """
 
@@ -26,9 +26,9 @@ from pathlib import Path
 from autograder.core import report
 from autograder.core.report import RawReport, RawTest
 from autograder.core.settings import RunSettings
-from autograder.grading import template
+from autograder.grading import forked
 from autograder.grading.footprint import Footprint
-from autograder.grading.template import ForkedChild, TemplateGone
+from autograder.grading.forked import ForkedChild, TemplateGone
 from autograder.sandbox.domains import DomainLock
 from autograder.sandbox.isolation import Isolation, run_prefix, student_uid
 from autograder.sandbox.process import reap_recorded
@@ -186,7 +186,7 @@ def _launch(isolation: Isolation, args: Sequence[str], folder: Path, env: dict[s
             log: int, passed: Sequence[int]) -> Process:
     """The child pytest forked from this process's template, else (none, or it could not
     fork) exec'd as ``python -m pytest``, in strict isolation through ``unshare``."""
-    warm = template.shared(env)
+    warm = forked.shared(env)
     if warm is not None:
         with contextlib.suppress(TemplateGone):
             return warm.spawn(args, str(folder), env, log, passed, namespaces=isolation.strict)
