@@ -6,25 +6,31 @@ child namespaces of its own, and the exec path stays where the template is off."
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import signal
 import subprocess
 import sys
 from collections.abc import Iterator, Sequence
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
 
+from autograder.core.exercise import load_exercise
+from autograder.core.report import RawReport, RawTest
 from autograder.core.settings import RunSettings
 from autograder.grading import children, forked
 from autograder.grading.children import Child, bytecode_env, pytest_env
 from autograder.grading.forked import ForkedChild, Template, TemplateGone
+from autograder.grading.run import GRADER_FAULT, verdict
 from autograder.sandbox.domains import hold_domain
 from autograder.sandbox.isolation import Isolation
 
 # Seconds for a child to start or end on a loaded machine.
 WALL = 120.0
+SHOUT = Path(__file__).parents[1] / "fixtures" / "mini_course" / "assignments" / "shout"
 
 SELF = """\
 import json, os, sys
@@ -138,6 +144,20 @@ def test_the_plugin_loads_warm_and_pytest_still_imports_it_itself(
     assert child.wait(WALL) == 0, (tmp_path / "pytest.log").read_text()
 
 
+def test_threads_ask_one_template_at_once(warm: Template, tmp_path: Path) -> None:
+    """``grade-batch`` grades in threads that share the template: each gets its own child
+    and its own status."""
+    sources = {f"t{i}": f"def test_it():\n    assert {i} % 2 == 0\n" for i in range(4)}
+
+    def run(name: str) -> int:
+        folder = tmp_path / name
+        folder.mkdir()
+        return spawn(warm, folder, sources[name]).wait(WALL)
+
+    with ThreadPoolExecutor(max_workers=4) as pool:
+        assert list(pool.map(run, sources)) == [0, 1, 0, 1]
+
+
 def test_a_child_killed_by_sigkill_says_so(warm: Template, tmp_path: Path) -> None:
     child = spawn(warm, tmp_path, "import time\ndef test_waits():\n    time.sleep(300)\n")
     assert child.poll() is None
@@ -167,6 +187,12 @@ def test_a_template_that_dies_mid_run_is_the_graders_failure(tmp_path: Path) -> 
     ended = children.end(record)
     assert ended.returncode is None and ended.broken
     assert "how it ended is unknown" in ended.pytest_log
+    # Even where its report shows every test passed: the grader's failure, not a grade.
+    passed = RawTest(nodeid="tests/public/test_p.py::p", name="p", label="p", max_score=1,
+                     visibility="visible", reveal="message", done=True, status="passed")
+    ended = dataclasses.replace(ended, raw=RawReport(tests=[passed]))
+    result = verdict(load_exercise(SHOUT), ended.raw, [ended], 1.0)
+    assert result.grader_error == GRADER_FAULT and "unknown" in result.grader_details
 
 
 def test_a_template_that_cannot_start_is_said_so(tmp_path: Path) -> None:
