@@ -234,10 +234,14 @@ def test_children_in_strict_isolation_have_namespaces_of_their_own(
     assert [c.wait(WALL) for c in forked] == [0, 0]
 
 
-def test_with_the_template_off_children_are_execd(monkeypatch: pytest.MonkeyPatch,
-                                                  tmp_path: Path) -> None:
-    monkeypatch.setenv(forked.SWITCH, "0")
-    assert forked.shared(child_env()) is None
+@pytest.mark.parametrize("switch", ["1", "0"], ids=["forked", "execd"])
+def test_a_grading_forks_its_children_unless_the_template_is_off(
+        switch: str, monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    """The grading's own start of a child: forked from this process's template, or with
+    ``AUTOGRADER_CHILD_TEMPLATE=0`` exec'd as before; either way the child loads the
+    plugin, reads its settings and says the same (here: no such exercise)."""
+    monkeypatch.setenv(forked.SWITCH, switch)
+    assert (forked.shared(child_env()) is None) == (switch == "0")
     test = tmp_path / "tests" / "test_it.py"
     test.parent.mkdir()
     test.write_text("def test_passes():\n    pass\n")
@@ -245,5 +249,7 @@ def test_with_the_template_off_children_are_execd(monkeypatch: pytest.MonkeyPatc
     with hold_domain() as lock, children.started(
             Isolation("basic"), settings, [str(test)], tmp_path / "child", tmp_path,
             lock) as child:
-        assert isinstance(child.process, subprocess.Popen)
-        child.process.wait(WALL)
+        kind = ForkedChild if switch == "1" else subprocess.Popen
+        assert isinstance(child.process, kind)
+        assert child.process.wait(WALL) == 3  # pytest's internal error: the plugin's
+        assert "No exercise named" in child.log_path.read_text()
