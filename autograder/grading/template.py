@@ -148,7 +148,7 @@ def _in_child(sock: socket.socket, request: Mapping[str, Any], fds: Sequence[int
     status = fds[0]
     try:
         signal.set_wakeup_fd(-1)
-        signal.signal(signal.SIGCHLD, signal.SIG_DFL)
+        _default_signals()
         sock.detach()  # closed by number, next
         close_all_but(fds)
         os.setsid()
@@ -159,6 +159,16 @@ def _in_child(sock: socket.socket, request: Mapping[str, Any], fds: Sequence[int
         _write(status, {"error": f"{type(exc).__name__}: {exc}"})
         os._exit(SETUP_FAILED)
     _status_fd = status
+
+
+def _default_signals() -> None:
+    """Every signal as a fresh interpreter has it, whatever the template inherited: SIGINT
+    raises KeyboardInterrupt, SIGPIPE and SIGXFSZ are ignored, the rest default."""
+    python = {signal.SIGINT: signal.default_int_handler, signal.SIGPIPE: signal.SIG_IGN,
+              signal.SIGXFSZ: signal.SIG_IGN}
+    for signum in signal.valid_signals() - {signal.SIGKILL, signal.SIGSTOP}:
+        with contextlib.suppress(OSError, ValueError):  # those the C library keeps
+            signal.signal(signum, python.get(signum, signal.SIG_DFL))
 
 
 def _own_namespaces(libc: ctypes.CDLL) -> None:

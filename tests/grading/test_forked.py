@@ -33,7 +33,7 @@ WALL = 120.0
 SHOUT = Path(__file__).parents[1] / "fixtures" / "mini_course" / "assignments" / "shout"
 
 SELF = """\
-import json, os, sys
+import json, os, signal, sys
 
 def test_self():
     fds = {}
@@ -45,7 +45,10 @@ def test_self():
     seen = {"argv": [os.path.basename(sys.argv[0]), *sys.argv[1:]], "cwd": os.getcwd(),
             "path0": sys.path[0], "env": os.environ.get("MARK"),
             "pycache": sys.pycache_prefix, "sid": os.getsid(0) == os.getpid(),
-            "fds": fds, "stdin": os.readlink("/proc/self/fd/0")}
+            "fds": fds, "stdin": os.readlink("/proc/self/fd/0"),
+            "signals": {s.name: str(signal.getsignal(s)) for s in (
+                signal.SIGINT, signal.SIGTERM, signal.SIGPIPE, signal.SIGCHLD,
+                signal.SIGHUP, signal.SIGXFSZ, signal.SIGUSR1)}}
     with open(os.environ["OUT"], "w") as out:
         json.dump(seen, out)
 """
@@ -81,7 +84,7 @@ def spawn(warm: Template, folder: Path, source: str, passed: Sequence[int] = (),
 def test_a_forked_child_sees_itself_as_an_execd_one(warm: Template, tmp_path: Path) -> None:
     """The same test module forked and exec'd: the same descriptors (the passed ones at
     the numbers asked, on the same pipes, nothing of the template's), arguments, folder,
-    module path, environment, bytecode cache, session and stdin."""
+    module path, environment, bytecode cache, session, stdin and signal handlers."""
     read_end, write_end = os.pipe()
     passed = [os.dup(read_end), os.dup(write_end)]
     seen = {}
