@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Literal, TypeVar
 
 from autograder.core.results import RunResult
+from autograder.grading.forked import forked_cpu_seconds
 from autograder.i18n import _, ngettext
 
 # Cores the gradings may ask for together, as a multiple of the cores there are. Above 1:
@@ -164,9 +165,13 @@ def machine_memory_mb(root: Path = CGROUP) -> float:
 # -- one grading ----------------------------------------------------------------------------
 
 def _cpu_seconds() -> float:
+    """This process's CPU time and its ended children's: those it waited for, and the
+    template and the child pytests it forked (their parent is the template, which is
+    waited for only at exit)."""
     own, children = (resource.getrusage(who) for who in
                      (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN))
-    return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
+    return (own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
+            + forked_cpu_seconds())
 
 
 def measured(work: Callable[[], T]) -> tuple[T, float]:

@@ -5,7 +5,9 @@ signed report, key, lifeline and settings (see :func:`autograder.grading.run.gra
 The child inherits its domain's lock (it holds the domain as long as it lives) and the
 read end of a *lifeline* pipe whose write end only the grader holds: when the grader
 dies, however it dies, the child sees the pipe close and ends itself and every student
-process it started (see ``autograder.plugin``).
+process it started (see ``autograder.plugin``).  It is forked from this process's
+template where there is one (:mod:`autograder.grading.forked`), else exec'd as
+``python -m pytest``: the same child either way.
 """
 
 from __future__ import annotations
@@ -24,13 +26,16 @@ from pathlib import Path
 from autograder.core import report
 from autograder.core.report import RawReport, RawTest
 from autograder.core.settings import RunSettings
+from autograder.grading import forked
 from autograder.grading.footprint import Footprint
+from autograder.grading.forked import ForkedChild, TemplateGone
 from autograder.sandbox.domains import DomainLock
-from autograder.sandbox.isolation import student_uid
+from autograder.sandbox.isolation import Isolation, run_prefix, student_uid
 from autograder.sandbox.process import reap_recorded
 from autograder.sandbox.sweep import sweep_user
 
 Progress = Callable[[RawTest], None]
+Process = subprocess.Popen[bytes] | ForkedChild
 
 
 @dataclasses.dataclass(frozen=True)
@@ -45,7 +50,7 @@ class Watchers:
 class Child:
     """One running child pytest and where it reports."""
 
-    process: subprocess.Popen[bytes]
+    process: Process
     report_path: Path
     key: bytes
     log_path: Path
@@ -107,7 +112,9 @@ class Ended:
     def broken(self) -> bool:
         """It ended without reporting its tests: a crash or a test file that does not
         import, or the time limit before any test was collected; or something stopped it
-        (a program of the grader's own user, in basic isolation): never a verdict."""
+        (a program of the grader's own user, in basic isolation): never a verdict.  How it
+        ended may be unknown (None: the template it was forked from died): broken too,
+        unless the time limit ended it (then the grader's own kill did)."""
         return (self.returncode not in (0, 1) and not self.timed_out) or self.stopped or (
             not self.raw.forged and not self.raw.tests)
 
@@ -156,13 +163,14 @@ def pytest_env(env: dict[str, str]) -> dict[str, str]:
 
 
 @contextlib.contextmanager
-def started(prefix: Sequence[str], settings: RunSettings, targets: Sequence[str],
+def started(isolation: Isolation, settings: RunSettings, targets: Sequence[str],
             folder: Path, rootdir: Path, lock: DomainLock, *,
             zygote: bool = True, hold_key: bool = False) -> Iterator[Child]:
-    """Start one child pytest over ``targets`` (test folders or modules) in ``folder``;
-    its lifeline closes when the block ends.  ``zygote``: whether it forks students'
-    programs from a zygote (see :func:`autograder.sandbox.process.warm_start`).
-    ``hold_key``: its key is sent only at :meth:`Child.release` (it waits for it)."""
+    """Start one child pytest over ``targets`` (test folders or modules) in ``folder``, in
+    namespaces of its own in strict ``isolation``; its lifeline closes when the block
+    ends.  ``zygote``: whether it forks students' programs from a zygote (see
+    :func:`autograder.sandbox.process.warm_start`).  ``hold_key``: its key is sent only at
+    :meth:`Child.release` (it waits for it)."""
     folder.mkdir(parents=True, exist_ok=True)
     report_path = folder / "report.json"
     key = secrets.token_bytes(32)
@@ -170,10 +178,10 @@ def started(prefix: Sequence[str], settings: RunSettings, targets: Sequence[str]
     life_read, life_write = os.pipe()
     settings = dataclasses.replace(settings, report=str(report_path), key_fd=key_read,
                                    lifeline_fd=life_read, domain=lock.domain)
-    command = [
-        *prefix, sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
-        "-p", "autograder.plugin", "--rootdir", str(rootdir), "--basetemp",
-        str(folder / "pytest"), "--autograder-settings", settings.to_json(), *targets,
+    args = [
+        "-q", "-p", "no:cacheprovider", "-p", "autograder.plugin", "--rootdir", str(rootdir),
+        "--basetemp", str(folder / "pytest"), "--autograder-settings", settings.to_json(),
+        *targets,
     ]
     env = pytest_env(bytecode_env(dict(os.environ)))
     if not zygote:
@@ -183,10 +191,8 @@ def started(prefix: Sequence[str], settings: RunSettings, targets: Sequence[str]
     try:
         with log_path.open("wb") as log:
             launched = time.monotonic()
-            process = subprocess.Popen(command, cwd=folder, env=env, stdout=log,
-                                       stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
-                                       start_new_session=True,
-                                       pass_fds=(key_read, life_read, *lock.fds))
+            process = _launch(isolation, args, folder, env, log.fileno(),
+                              (key_read, life_read, *lock.fds))
         os.close(key_read)
         os.close(life_read)
         child = Child(process, report_path, key, log_path, launched,
@@ -199,6 +205,31 @@ def started(prefix: Sequence[str], settings: RunSettings, targets: Sequence[str]
         if child is not None and child.key_pipe is not None:  # never released: it ends
             child.discard()
         os.close(life_write)
+
+
+def _launch(isolation: Isolation, args: Sequence[str], folder: Path, env: dict[str, str],
+            log: int, passed: Sequence[int]) -> Process:
+    """The child pytest forked from this process's template, else (none, or it could not
+    fork) exec'd as ``python -m pytest``, in strict isolation through ``unshare``.
+
+    Only where the student has a user of its own: in basic isolation its program is the
+    grader's user and may stop any process of it, the template too, whose children's
+    exit statuses would then never come; an exec'd child is the grader's own child, whose
+    end the grader sees whatever the program does."""
+    warm = forked.shared(env) if isolation.own_user else None
+    if warm is not None:
+        with contextlib.suppress(TemplateGone):
+            return warm.spawn(args, str(folder), env, log, passed, namespaces=isolation.strict)
+    return subprocess.Popen([*run_prefix(isolation), sys.executable, "-m", "pytest", *args],
+                            cwd=folder, env=env, stdout=log, stderr=subprocess.STDOUT,
+                            stdin=subprocess.DEVNULL, start_new_session=True,
+                            pass_fds=passed)
+
+
+def forked_from(children: Sequence[Child]) -> list[int]:
+    """The templates ``children`` were forked from (their pids): processes of the
+    grading's tree that are not its children's ancestors."""
+    return sorted({c.process.template for c in children if isinstance(c.process, ForkedChild)})
 
 
 def wait(children: Sequence[Child], limit: float, watchers: Watchers,
@@ -296,5 +327,9 @@ def end(child: Child) -> Ended:
     if child.stopped:
         log += ("\nThe grading's pytest process was stopped from outside (SIGSTOP or a "
                 "tracer): its report is not trusted.\n")
-    return Ended(raw, child.process.returncode, child.timed_out, log, child.launched,
-                 child.stopped)
+    returncode = child.process.returncode
+    if isinstance(child.process, ForkedChild) and child.process.lost:
+        returncode = None
+        log += ("\nThe process this pytest was forked from ended before it did: how it "
+                "ended is unknown.\n")
+    return Ended(raw, returncode, child.timed_out, log, child.launched, child.stopped)

@@ -12,12 +12,14 @@ older than 4.14) counts its resident size from ``/proc/PID/statm`` instead, whic
 may read: more than its PSS, so the sum errs upwards. One that ended between being listed
 and being read counts nothing. A sample never fails.
 
-The tree is the grader itself and each child pytest (which holds the world and the probe)
-with all its descendants (the students' programs and anything they started), found
+The tree is the grader itself, the template the child pytests were forked from if they
+were (:mod:`autograder.grading.template`), and each child pytest (which holds the world
+and the probe) with all its descendants (the students' programs and anything they
+started), found
 through each thread's ``/proc/PID/task/TID/children``: that reads a file per thread of
 the tree, where a scan of every ``/proc/PID/stat`` for parent ids would read one per
-process on the machine. The grader counts alone: in ``grade-batch`` its other
-descendants are other gradings'. A process whose parent ended has left the tree (the
+process on the machine. The grader and the template count alone: in ``grade-batch``
+their other descendants are other gradings'. A process whose parent ended has left the tree (the
 kernel gives it to init), so it is not counted; nor is a peak that comes and goes between
 two samples.
 """
@@ -97,10 +99,11 @@ def process_kb(pid: int, proc: Path = PROC, page_kb: int | None = None) -> int:
 
 
 def tree_kb(own: int, roots: Sequence[int], proc: Path = PROC,
-            page_kb: int | None = None) -> int:
-    """The summed memory in KB (PSS, see :func:`process_kb`) of process ``own`` alone and of
-    each of ``roots`` with its descendants; each process counted once."""
-    pids = dict.fromkeys([own])
+            page_kb: int | None = None, alone: Sequence[int] = ()) -> int:
+    """The summed memory in KB (PSS, see :func:`process_kb`) of processes ``own`` and
+    ``alone`` by themselves and of each of ``roots`` with its descendants; each process
+    counted once."""
+    pids = dict.fromkeys([own, *alone])
     for root in roots:
         pids.update(dict.fromkeys([root, *descendants(root, proc)]))
     page_kb = _page_kb() if page_kb is None else page_kb
@@ -109,13 +112,15 @@ def tree_kb(own: int, roots: Sequence[int], proc: Path = PROC,
 
 @dataclasses.dataclass
 class Footprint:
-    """The peak summed PSS of a grading's tree: this process and the child pytests
-    ``roots`` with their descendants, sampled at most every ``interval`` seconds."""
+    """The peak summed PSS of a grading's tree: this process, the processes ``alone`` (the
+    template the children were forked from) and the child pytests ``roots`` with their
+    descendants, sampled at most every ``interval`` seconds."""
 
     roots: Sequence[int]
     interval: float = INTERVAL
     proc: Path = PROC
     own: int = dataclasses.field(default_factory=os.getpid)
+    alone: Sequence[int] = ()
     peak_kb: int = 0
     samples: int = 0
     _last: float = dataclasses.field(default=-math.inf, init=False, repr=False)
@@ -127,7 +132,8 @@ class Footprint:
         if now - self._last < self.interval * 0.9:
             return
         self._last = now
-        self.peak_kb = max(self.peak_kb, tree_kb(self.own, self.roots, self.proc))
+        self.peak_kb = max(self.peak_kb, tree_kb(self.own, self.roots, self.proc,
+                                                 alone=self.alone))
         self.samples += 1
 
     @property

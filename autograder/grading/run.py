@@ -55,7 +55,6 @@ from autograder.sandbox.isolation import (
     detect,
     detection,
     protected_paths,
-    run_prefix,
     student_uid,
 )
 from sim.recorder import Recording
@@ -251,7 +250,7 @@ def _run(exercise: Exercise, submission: Path | None, plan: _Plan,
                     for index, (group, lock) in enumerate(zip(targets, locks, strict=False)):
                         count_only = tuple(str(f) for f in plan.count_only if f in group)
                         running.append(lifelines.enter_context(children.started(
-                            run_prefix(isolation),
+                            isolation,
                             dataclasses.replace(settings, count_only=count_only),
                             [str(t) for t in group], Path(tmp) / f"child-{index}",
                             exercise.folder, lock, hold_key=True)))
@@ -264,7 +263,8 @@ def _run(exercise: Exercise, submission: Path | None, plan: _Plan,
                         close_to_others(protected_paths(exercise.folder.parent.parent))
                     for child in running:
                         child.release()
-                    footprint = Footprint([child.process.pid for child in running])
+                    footprint = Footprint([child.process.pid for child in running],
+                                          alone=children.forked_from(running))
                     children.wait(running, exercise.time_limit, watchers, footprint)
                 break
         except BaseException:  # stopped (a signal, Ctrl-C): the children go before tmp

@@ -101,6 +101,14 @@ def test_the_tree_is_the_grader_alone_and_each_child_with_its_descendants(proc: 
     assert tree_kb(10, [], proc, page_kb=4) == 30_000
 
 
+def test_the_template_counts_alone_and_once(proc: Path) -> None:
+    """The template the child pytests were forked from (12 here) counts by itself, not
+    its other children (other gradings'), and once if it is reached twice."""
+    _process(proc, 12, pss=5_000, threads={12: [99]})
+    assert tree_kb(10, [20], proc, page_kb=4, alone=[12]) == 134_000 + 5_000
+    assert tree_kb(10, [20], proc, page_kb=4, alone=[12, 10, 20]) == 139_000
+
+
 def test_the_footprint_keeps_the_peak_sampling_at_most_every_interval(proc: Path) -> None:
     footprint = Footprint([20], interval=0.5, proc=proc, own=10)
     assert footprint.peak_mb is None
