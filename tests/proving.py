@@ -451,9 +451,12 @@ def references_simulation_seconds(graded: dict[str, RunResult]) -> dict[str, flo
     return {test: statistics.median(values) for test, values in runs.items()}
 
 
-# A test's simulation seconds move by a tick or a few with when the node reacts: the README
-# gives them to a tenth, and they hold within this much (seconds, or a fraction of them).
-SIM_SECONDS_SLACK = (1.0, 0.15)
+# A test's simulation seconds move with when the node reacts, and a service call's or a
+# discovery's wall time passes in simulation time at the world's pace (callback_groups'
+# test_ignores_invalid_readings read 3.0 s on a loaded machine, 4.1 s in a quiet CI run):
+# the README gives them to a tenth, and they hold within this much (seconds, or a
+# fraction of them).
+SIM_SECONDS_SLACK = (1.5, 0.25)
 
 
 def test_readme_gives_each_tests_simulation_seconds(graded: dict[str, RunResult],

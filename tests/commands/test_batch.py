@@ -111,16 +111,21 @@ def _processes() -> dict[int, tuple[int, str]]:
 
 
 def run_folders(processes: set[tuple[int, str]]) -> set[Path]:
-    """The temporary folders of the gradings among ``processes`` (their pytest children)."""
+    """The temporary folders of the gradings among ``processes`` (their pytest children):
+    an exec'd child names its settings on its command line; one forked from the grader's
+    template (whose command line it shows) works in its folder, beside its log."""
     found = set()
     for pid, _start in processes:
         try:
             args = Path(f"/proc/{pid}/cmdline").read_bytes().split(b"\0")
+            cwd = Path(os.readlink(f"/proc/{pid}/cwd"))
         except OSError:
             continue
         if b"--autograder-settings" in args:
             settings = RunSettings.from_json(args[args.index(b"--autograder-settings") + 1])
             found.add(Path(settings.report).parent)
+        elif b"autograder.grading.template" in args and (cwd / "pytest.log").exists():
+            found.add(cwd)
     return found
 
 
