@@ -13,7 +13,6 @@ start or died, an environment it did not start with), children are exec'd.
 from __future__ import annotations
 
 import atexit
-import contextlib
 import json
 import os
 import select
@@ -27,6 +26,7 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from autograder.grading.template import MAX_MESSAGE
+from autograder.sandbox.contained.zygote import close_server
 
 SWITCH = "AUTOGRADER_CHILD_TEMPLATE"  # "0": every child pytest is exec'd
 # Read once per forked child: the bytecode cache (bytecode_env in children.py).
@@ -211,14 +211,7 @@ class Template:
 
     def close(self) -> None:
         """Close the template's socket (it then ends) and wait for it."""
-        with contextlib.suppress(OSError):
-            self._sock.shutdown(socket.SHUT_RDWR)
-        self._sock.close()
-        try:
-            self.process.wait(5.0)
-        except subprocess.TimeoutExpired:
-            self.process.kill()
-            self.process.wait()
+        close_server(self._sock, self.process)
 
 
 # -- this process's template ---------------------------------------------------------------

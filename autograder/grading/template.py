@@ -38,7 +38,11 @@ import traceback
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from autograder.sandbox.contained.zygote import close_all_but, fork_with_hooks
+from autograder.sandbox.contained.zygote import (
+    close_all_but,
+    ended_children,
+    fork_with_hooks,
+)
 
 # What a child pytest imports: imported once here instead of in every child; a missing
 # one is skipped.  The plugin's package module is then forgotten, so that pytest imports
@@ -121,13 +125,7 @@ def serve(fd: int) -> list[str]:
 def _reap(statuses: dict[int, int]) -> None:
     """Wait for the children that have ended and tell the grader how each ended, with the
     CPU time it and what it waited for used (a batch counts its CPU with it)."""
-    while True:
-        try:
-            pid, status, usage = os.wait4(-1, os.WNOHANG)
-        except ChildProcessError:
-            return
-        if pid == 0:
-            return
+    for pid, status, usage in ended_children():
         fd = statuses.pop(pid, None)
         if fd is not None:
             _write(fd, {"status": status, "cpu": usage.ru_utime + usage.ru_stime})

@@ -33,7 +33,7 @@ import socket
 import subprocess
 import sys
 import threading
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from typing import Any
 
 from autograder.sandbox.contained.launcher import LAUNCH_FAILED, contain
@@ -169,9 +169,10 @@ def close_all_but(keep: Sequence[int]) -> None:
     os.closerange(low, os.sysconf("SC_OPEN_MAX"))
 
 
-def _reap(sock: socket.socket) -> None:
-    """Wait for the programs that have ended (so their CPU time counts in the zygote's
-    children's, and through it in the grader's) and tell the grader how each ended."""
+def ended_children() -> Iterator[tuple[int, int, Any]]:
+    """The children of this process that have ended, waited for (pid, wait status,
+    resource usage), without blocking: a forking server's reaping (the zygote's, the
+    grader's template's)."""
     while True:
         try:
             pid, status, usage = os.wait4(-1, os.WNOHANG)
@@ -179,6 +180,26 @@ def _reap(sock: socket.socket) -> None:
             return
         if pid == 0:
             return
+        yield pid, status, usage
+
+
+def close_server(sock: socket.socket, process: subprocess.Popen[Any]) -> None:
+    """Close a forking server's socket (it then ends) and wait for it, killed if it has
+    not ended within 5 s."""
+    with contextlib.suppress(OSError):
+        sock.shutdown(socket.SHUT_RDWR)
+    sock.close()
+    try:
+        process.wait(5.0)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        process.wait()
+
+
+def _reap(sock: socket.socket) -> None:
+    """Wait for the programs that have ended (so their CPU time counts in the zygote's
+    children's, and through it in the grader's) and tell the grader how each ended."""
+    for pid, status, usage in ended_children():
         with contextlib.suppress(OSError):
             _send(sock, {"exited": pid, "status": status, "maxrss_kb": usage.ru_maxrss})
 
@@ -353,14 +374,7 @@ class Zygote:
             self._lock.notify_all()
 
     def close(self) -> None:
-        with contextlib.suppress(OSError):
-            self._sock.shutdown(socket.SHUT_RDWR)
-        self._sock.close()
-        try:
-            self.process.wait(5.0)
-        except subprocess.TimeoutExpired:
-            self.process.kill()
-            self.process.wait()
+        close_server(self._sock, self.process)
 
 
 def _orphan_status(pid: int, timeout: float | None) -> int | None:
