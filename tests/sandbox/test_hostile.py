@@ -265,7 +265,7 @@ def test_ipc_objects_and_scratch_files_go_with_the_program(graded):
     """SysV shared memory, queues and semaphores, a POSIX queue and files in /dev/shm and
     /tmp: the program's own namespaces held them, and none is on the machine after."""
     result = graded["ipc_leftovers"][0]
-    assert result.score == result.max_score
+    assert result.score == result.max_score, _lost(result)
     keys = {int(key, 16) for key in re.findall(r"^IPC SHM (0x[0-9a-f]+)", result.log, re.M)}
     assert keys, "the program made its segments"
     for kind in ("shm", "msg", "sem"):
@@ -276,6 +276,12 @@ def test_ipc_objects_and_scratch_files_go_with_the_program(graded):
     assert names
     for name in names:
         assert not Path(name).exists() and not Path("/dev/mqueue", name.lstrip("/")).exists()
+
+
+def _lost(result: RunResult) -> str:
+    """What each lost test said, and the grader's error: a failed check in CI says why."""
+    return json.dumps({"grader_error": result.grader_error, "lost": {
+        t.name: t.message for t in result.tests if t.status != "passed"}}, indent=1)
 
 
 @strict_only
