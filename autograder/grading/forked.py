@@ -26,7 +26,7 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from autograder.grading.template import MAX_MESSAGE
-from autograder.sandbox.contained.zygote import close_server
+from autograder.sandbox.contained.zygote import close_server, start_server
 
 SWITCH = "AUTOGRADER_CHILD_TEMPLATE"  # "0": every child pytest is exec'd
 # Read once per forked child: the bytecode cache (bytecode_env in children.py).
@@ -144,18 +144,11 @@ class Template:
 
     def __init__(self, env: Mapping[str, str]) -> None:
         self.startup = startup_env(env)
-        ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
         try:
-            self.process = subprocess.Popen(
-                [sys.executable, "-m", "autograder.grading.template", str(theirs.fileno())],
-                env={**env, "OPENBLAS_NUM_THREADS": "1"}, cwd="/", stdin=subprocess.DEVNULL,
-                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True,
-                pass_fds=(theirs.fileno(),))
+            self.process, ours = start_server(
+                [sys.executable, "-m", "autograder.grading.template"], env, "/")
         except OSError as exc:
-            ours.close()
             raise TemplateGone(str(exc)) from exc
-        finally:
-            theirs.close()
         self.pid = self.process.pid
         self._sock = ours
         self._lock = threading.Lock()

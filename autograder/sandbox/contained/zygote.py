@@ -183,6 +183,25 @@ def ended_children() -> Iterator[tuple[int, int, Any]]:
         yield pid, status, usage
 
 
+def start_server(command: Sequence[str], env: Mapping[str, str],
+                 cwd: str) -> tuple[subprocess.Popen[bytes], socket.socket]:
+    """Start a forking server (the zygote, the grader's template) as ``command`` + the
+    number of its end of a socket pair, in a session of its own; it and our end. OSError:
+    it could not be started."""
+    ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
+    try:
+        process = subprocess.Popen(
+            [*command, str(theirs.fileno())], env={**env, "OPENBLAS_NUM_THREADS": "1"},
+            cwd=cwd, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL, start_new_session=True, pass_fds=(theirs.fileno(),))
+    except OSError:
+        ours.close()
+        raise
+    finally:
+        theirs.close()
+    return process, ours
+
+
 def close_server(sock: socket.socket, process: subprocess.Popen[Any]) -> None:
     """Close a forking server's socket (it then ends) and wait for it, killed if it has
     not ended within 5 s."""
@@ -283,18 +302,11 @@ class Zygote:
 
     def __init__(self, python: str, env: Mapping[str, str], cwd: str) -> None:
         self.env = dict(env)
-        ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
         try:
-            self.process = subprocess.Popen(
-                [python, "-s", "-m", "autograder.sandbox.contained.zygote", str(theirs.fileno())],
-                env={**env, "OPENBLAS_NUM_THREADS": "1"}, cwd=cwd, stdin=subprocess.DEVNULL,
-                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True,
-                pass_fds=(theirs.fileno(),))
+            self.process, ours = start_server(
+                [python, "-s", "-m", "autograder.sandbox.contained.zygote"], env, cwd)
         except OSError as exc:
-            ours.close()
             raise ZygoteGone(str(exc)) from exc
-        finally:
-            theirs.close()
         self._sock = ours
         self._lock = threading.Condition()
         self._replies: list[dict] = []
