@@ -19,7 +19,10 @@ from autograder.quiz.server import QuizServer
 def server() -> Iterator[QuizServer]:
     """``quiz serve`` of the frozen quiz course on a free port, in a thread."""
     srv = QuizServer(load_all(QUIZ_COURSE), port=0)
-    thread = threading.Thread(target=srv.serve_forever, daemon=True)
+    # serve_forever looks for shutdown() between requests every poll_interval (0.5 s by
+    # default): each test's teardown would wait that long for nothing
+    thread = threading.Thread(target=srv.serve_forever, kwargs={"poll_interval": 0.02},
+                              daemon=True)
     thread.start()
     yield srv
     srv.shutdown()

@@ -98,7 +98,7 @@ def test_the_others_are_found_and_the_broken_one_says_why(course: Path) -> None:
 def test_serve_serves_the_others(course: Path) -> None:
     files, _errors = load_each()
     server = QuizServer(files, 0, "en")
-    thread = Thread(target=server.serve_forever, daemon=True)
+    thread = Thread(target=server.serve_forever, kwargs={"poll_interval": 0.02}, daemon=True)
     thread.start()
     try:
         page = urllib.request.urlopen(server.url + "quiz/good", timeout=10).read().decode()

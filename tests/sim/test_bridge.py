@@ -244,11 +244,9 @@ def test_watched_process_paces_sim_time(graph: tuple[SimBridge, Probe]) -> None:
         # It hears no ticks (it has no node): the first is held hear_timeout for it.
         unheard = bridge.pacing.get("unheard", 0)
         assert bridge.wait_for(lambda: bridge.pacing.get("unheard", 0) > unheard, 5.0, WALL)
-        bridge.pacer.forget_rate()  # measure from here, not over that hold
         before = dict(bridge.pacing)
-        free = _rtf_over(bridge, 0.4)
-        waited_for_idle = bridge.pacing["idle"] - before.get("idle", 0)
-        unheard_again = bridge.pacing.get("unheard", 0) - before.get("unheard", 0)
+        assert bridge.wait_until(bridge.now + 0.4, wall_timeout=WALL)
+        ended = {k: bridge.pacing.get(k, 0) - before.get(k, 0) for k in set(bridge.pacing)}
     finally:
         bridge.watch_pid(None)
         for proc in (busy, idle):
@@ -256,9 +254,13 @@ def test_watched_process_paces_sim_time(graph: tuple[SimBridge, Probe]) -> None:
             proc.wait()
     # A tick is 0.02 s of sim time; a busy process gets 0.05 s of CPU before it passes.
     assert slowed < 0.6, slowed
-    assert free > 0.85, (free, bridge.pacing)
-    assert let_go > 0 and waited_for_idle > 0, bridge.pacing  # what the results report
-    assert unheard_again == 0, bridge.pacing  # not waited for to hear again
+    assert let_go > 0, bridge.pacing  # what the results report
+    # The idle one held no tick for its CPU share or to hear it again: each hold ended as
+    # soon as it was seen idle. (Not the pace measured on the wall clock: on a loaded
+    # machine the world's own thread runs late, whoever it watches; 0.60 was seen with
+    # four test workers on 2 cores.)
+    assert ended.get("idle", 0) > 0, ended
+    assert not any(ended.get(k, 0) for k in ("budget", "unheard", "cap")), ended
 
 
 STUDENT = """
