@@ -24,7 +24,6 @@ from pathlib import Path
 from autograder.commands import gradebook
 from autograder.core.files import write_atomically
 from autograder.core.results import RunResult
-from autograder.grading.capacity import MAX_JOBS
 
 # Told of each grading as it ends (its wall seconds, its results, how many ran at once
 # then, itself included, and how many students are left, running or not), the
@@ -85,7 +84,9 @@ def run_batch(entries: dict[str, Path], grade_one: Callable[[Path], RunResult], 
 
     With a chooser for ``jobs``, the first student to grade is graded alone, and the
     chooser sets the concurrency again each time a grading ends (never above
-    :data:`~autograder.grading.capacity.MAX_JOBS`)."""
+    :func:`~autograder.grading.capacity.max_jobs` of the machine's cores). The pool
+    makes its threads as gradings are started, so one as large as the queue holds only
+    as many as ran at once."""
     mine = {s: p for s, p in entries.items() if in_shard(s, shard)}
     todo = {s: p for s, p in mine.items() if not _results_path(out, s).exists()}
     lock = threading.Lock()
@@ -108,7 +109,7 @@ def run_batch(entries: dict[str, Path], grade_one: Callable[[Path], RunResult], 
     chooser = jobs if callable(jobs) else None
     limit = 1 if chooser is not None else max(1, int(jobs))  # type: ignore[arg-type]
     running: set[Future[tuple[RunResult, float]]] = set()
-    workers = min(MAX_JOBS, len(queue)) if chooser is not None else limit
+    workers = len(queue) if chooser is not None else limit
     with ThreadPoolExecutor(max_workers=max(1, workers)) as pool:
         while queue or running:
             while queue and len(running) < limit:

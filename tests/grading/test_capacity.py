@@ -24,6 +24,7 @@ from autograder.grading.capacity import (
     choose_jobs,
     decide,
     describe,
+    max_jobs,
     starved,
 )
 
@@ -31,20 +32,28 @@ MACHINE = {"cores": 2.0, "memory_mb": 8000.0, "grading_mb": 400.0}
 
 
 @pytest.mark.parametrize(("share", "students", "memory", "jobs", "bound"), [
-    (0.6, 20, 8000.0, 6, "cpu"),        # clock-bound: several per core
+    (1.2, 20, 8000.0, 3, "cpu"),        # more than a core: fewer than two a core
     (1.0, 20, 8000.0, 4, "cpu"),        # CPU-bound: two a core at most
-    (0.7, 20, 8000.0, 5, "cpu"),
+    (1.5, 20, 8000.0, 2, "cpu"),
     (0.2, 3, 8000.0, 3, "students"),    # no more than there are students
     (0.2, 20, 1000.0, 2, "memory"),     # 1000 MB at 400 MB each
-    (0.01, 20, 8000.0, 8, "ceiling"),   # a grading that hardly computes: the checked most
+    (0.01, 20, 8000.0, 4, "ceiling"),   # a grading that hardly computes: two a core
     (5.0, 20, 100.0, 1, "cpu"),         # nothing fits: still one
-    (0.01, 20, float("inf"), 8, "ceiling"),  # free memory unknown: not a bound
-], ids=["clock-bound", "cpu-bound", "half-core", "few-students", "low-memory", "ceiling",
+    (0.01, 20, float("inf"), 4, "ceiling"),  # free memory unknown: not a bound
+], ids=["over-a-core", "cpu-bound", "core-and-a-half", "few-students", "low-memory", "ceiling",
         "never-zero", "memory-unknown"])
 def test_choose_jobs(share, students, memory, jobs, bound) -> None:
     choice = choose_jobs(**{**MACHINE, "memory_mb": memory}, cpu_share=share,
                          students=students)
     assert (choice.jobs, choice.bound) == (jobs, bound)
+
+
+@pytest.mark.parametrize(("cores", "most"), [(2.0, 4), (4.0, 8), (1.5, 3), (0.4, 1)])
+def test_the_ceiling_is_two_gradings_a_core(cores, most) -> None:
+    """Eight at once on 2 cores lost a correct node's test now and then; four did not."""
+    assert max_jobs(cores) == most
+    assert choose_jobs(cores=cores, memory_mb=8000.0, cpu_share=0.01, grading_mb=1.0,
+                       students=100).jobs == most
 
 
 def test_a_first_grading_that_only_hangs_is_not_believed_to_cost_nothing() -> None:
@@ -125,7 +134,7 @@ def test_a_tally_shares_the_mean_cpu_over_the_first_wall() -> None:
 def test_a_starved_student_caps_the_concurrency_below_where_it_happened() -> None:
     tally = Tally().add(wall=10.0, cpu_seconds=0.5, footprint_mb=None, strained=False,
                         at_once=1)
-    machine = {"cores": 2.0, "memory_mb": 8000.0, "students": 50}
+    machine = {"cores": 4.0, "memory_mb": 8000.0, "students": 50}
     assert decide(tally, **machine).bound == "ceiling"
     tally = tally.add(wall=12.0, cpu_seconds=0.5, footprint_mb=None, strained=True,
                       at_once=5)
@@ -148,15 +157,15 @@ def test_starved_reads_the_pacing_cap(pacing, expected) -> None:
 
 
 def test_the_chooser_decides_again_and_says_so_only_when_the_number_changes() -> None:
-    cpu = iter([0.0, 8.0, 8.5, 12.0, 13.0])  # the batch's CPU at the start and each end
+    cpu = iter([0.0, 16.0, 17.0, 24.0, 26.0])  # the batch's CPU at the start and each end
     said: list[str] = []
-    chooser = AutoChooser(said.append, cores=lambda: 2.0, memory_mb=lambda: 8000.0,
+    chooser = AutoChooser(said.append, cores=lambda: 4.0, memory_mb=lambda: 8000.0,
                           cpu=lambda: next(cpu))
     plain, starving = _result(3), dataclasses.replace(
         _result(3), pacing={"m": ModulePacing.from_dict({"cap": 2})})
-    assert chooser(10.0, plain, 1, 10) == 5  # 0.8 of a core: 2 cores x 2.0 / 0.8
-    assert chooser(20.0, plain, 5, 9) == 8  # a mean of 4.25 s over the first 10 s: 0.425
-    assert chooser(25.0, plain, 8, 8) == 8  # 0.4: still the ceiling, nothing said
+    assert chooser(10.0, plain, 1, 10) == 5  # 1.6 cores: 4 cores x 2.0 / 1.6
+    assert chooser(20.0, plain, 5, 9) == 8  # a mean of 8.5 s over the first 10 s: the ceiling
+    assert chooser(25.0, plain, 8, 8) == 8  # 0.8: still the ceiling, nothing said
     assert chooser(25.0, starving, 7, 7) == 6  # starved at 7
     assert [line.split(".")[0] for line in said] == [
         "--jobs auto: 5 gradings at a time", "--jobs auto: 8 gradings at a time",
