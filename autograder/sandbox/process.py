@@ -32,7 +32,7 @@ from autograder.core.exercise import Limits
 from autograder.sandbox.cgroups import Cgroup
 from autograder.sandbox.contained import runner
 from autograder.sandbox.privileged import PACKAGE_PARENT, SAFE_CWD, module_command
-from autograder.sandbox.sweep import is_student_uid, sweep_user, user_processes
+from autograder.sandbox.sweep import is_student_uid, kill_user, sweep_user, user_processes
 from sim.procstate import descendants
 
 _PASS_THROUGH = (
@@ -234,6 +234,10 @@ class LaunchFailed(GraderError):
 
 # Wall seconds the launcher has to contain the program and exec it (mounts, cgroups).
 LAUNCH_TIMEOUT = 60.0
+# Wall seconds a student's own user has, before its first program here starts, to be rid of
+# an earlier program's processes: its sweep waits for them already; this is for one whose
+# sweep did not end (the run killed), and a zombie still counts against RLIMIT_NPROC.
+USER_FREE_TIMEOUT = 30.0
 
 
 class BoundedOutput:
@@ -335,7 +339,12 @@ class StudentProcess:
             if p)
         if self.uid is not None:
             with _users_lock:
+                first = not _users.get(self.uid)
                 _users.setdefault(self.uid, set()).add(id(self))
+            if first and not kill_user(self.uid, USER_FREE_TIMEOUT):
+                _user_done(self)
+                raise LaunchFailed("user", f"user {self.uid} still has processes of an "
+                                   "earlier program that the machine has not reaped")
         with self.gate if self.gate is not None else contextlib.nullcontext():
             started = (self._fork(spec, args, launcher_env)
                        or self._exec(spec, args, launcher_env))

@@ -9,6 +9,11 @@ the kernel delivers to every process the sender may signal (all of that user's, 
 excepted) in one pass, so a program forking as fast as it can is not raced pid by pid.
 In strict isolation the program's IPC objects and ``/tmp`` are its own namespace's and go
 with it; the sweep is for where there is no namespace to take them.
+
+A sweep ends when the user has no task left at all, its zombies included: a killed process
+still counts against its user's ``RLIMIT_NPROC`` until its parent (for an orphan, the
+zygote or the machine's init) has reaped it, and the next program of that user (the next
+grading on the same ROS domain) would find its budget spent by the last one's fork bomb.
 """
 
 from __future__ import annotations
@@ -42,20 +47,26 @@ def user_processes(uid: int, proc: str = "/proc") -> list[int]:
 
 
 def kill_user(uid: int, timeout: float = 30.0) -> bool:
-    """SIGKILL every process of ``uid`` until none is left (or ``timeout`` wall seconds
-    pass); whether none is left. A killed process is listed until the kernel has freed it,
-    which a busy machine can take seconds over: the wait is for that, not for the kill."""
+    """SIGKILL every process of ``uid`` until none is left and none of them is still
+    counted against the user's ``RLIMIT_NPROC`` (or ``timeout`` wall seconds pass); whether
+    the user has no task left but the caller's own children's zombies, which are the
+    caller's to reap. A killed process is listed until the kernel has freed it and its
+    parent has reaped it, which a busy machine, or an init reaping a fork bomb's orphans,
+    can take seconds over: the wait is for that, not for the kill."""
     if not is_student_uid(uid) or uid in (os.getuid(), os.geteuid()):
         raise ValueError(f"will not sweep uid {uid}: not a student's own user")
     deadline = time.monotonic() + timeout
     setpriv = shutil.which("setpriv")
     while True:
-        pids = user_processes(uid)
-        if not pids:
+        tasks = [(pid, state) for pid, owner, state, _threads in process_statuses()
+                 if owner == uid]
+        pids = [pid for pid, state in tasks if state != b"Z"]
+        if not pids and all(parent_of(pid) == os.getpid() for pid, _state in tasks):
             return True
         if time.monotonic() > deadline:
             return False
-        if setpriv is not None:
+        # With only zombies left there is nothing to kill: their parents reap them.
+        if pids and setpriv is not None:
             subprocess.run([setpriv, f"--reuid={uid}", f"--regid={uid}", "--clear-groups",
                             sys.executable, "-I", "-S", "-c", _KILL_ALL], cwd="/",
                            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
@@ -67,6 +78,15 @@ def kill_user(uid: int, timeout: float = 30.0) -> bool:
                 except ProcessLookupError:
                     pass
         time.sleep(0.01)
+
+
+def parent_of(pid: int, proc: str = "/proc") -> int | None:
+    """The parent of ``pid`` now; None once it is gone."""
+    try:
+        with open(f"{proc}/{pid}/stat", "rb") as fh:
+            return int(fh.read().rpartition(b")")[2].split()[1])
+    except (OSError, IndexError, ValueError):
+        return None
 
 
 # The machine's shared scratch folders, where a program without a mount namespace of its
@@ -153,7 +173,7 @@ def remove_leftovers(uid: int, folders: tuple[str, ...] = SCRATCH) -> None:
 
 def sweep_user(uid: int) -> bool:
     """End every process of the student's ``uid``, then remove its IPC objects and scratch
-    files; whether no process was left."""
+    files; whether no task of it was left (see :func:`kill_user`)."""
     gone = kill_user(uid)
     remove_leftovers(uid)
     return gone

@@ -301,3 +301,54 @@ def test_reaping_sweeps_each_user_once_however_many_of_its_programs(monkeypatch)
                   [{"pid": gone, "cgroups": [], "uid": STUDENT_UID_BASE + 4},
                    {"pid": gone, "cgroups": [], "uid": 0}])
     assert swept == [STUDENT_UID_BASE + 3, STUDENT_UID_BASE + 4]
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(os.geteuid() != 0 or not shutil.which("setpriv"),
+                    reason="needs root and setpriv to act as a student's user")
+def test_a_user_an_earlier_program_still_holds_is_freed_or_the_launch_is_ours(
+        tmp_path, monkeypatch):
+    """Before the first program of a student's user starts here, what an earlier program
+    left as that user (a run killed before its sweep) is ended; a task of it that cannot
+    be ended in time (a zombie whose parent never reaps it, which still counts against the
+    user's RLIMIT_NPROC) makes the launch fail as the grader's fault, not start a program
+    short of its budget."""
+    from autograder.sandbox import process as process_module
+    from autograder.sandbox.contained.launcher import user_tasks
+    from autograder.sandbox.isolation import student_uid
+
+    domain = 228  # a domain no grading reserves
+    uid = student_uid(domain)
+    leftover = subprocess.Popen(["setpriv", f"--reuid={uid}", f"--regid={uid}", "--clear-groups",
+                                 "sleep", "600"], start_new_session=True)
+    # A parent that is not ours nor the student's, holding a zombie of the student's user.
+    holder = subprocess.Popen([sys.executable, "-c",
+                               "import os, sys, time\n"
+                               f"if os.fork() == 0:\n    os.setuid({uid})\n    os._exit(0)\n"
+                               "print('held', flush=True)\n"
+                               "time.sleep(600)\n"], stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout is not None and holder.stdout.readline() == "held\n"
+        monkeypatch.setattr(process_module, "USER_FREE_TIMEOUT", 1.0)
+        program = student_process(_program(tmp_path / "held", "print('ran')\n"), [], Limits(),
+                                  domain=domain, mode="user", course=COURSE)
+        with pytest.raises(LaunchFailed) as failure:
+            program.start()
+        assert failure.value.stage == "user"
+        assert leftover.wait(10.0) == -9  # the live leftover was ended all the same
+        holder.kill()  # its zombie goes to the machine's init, which reaps it in its time
+        holder.wait()
+        monkeypatch.setattr(process_module, "USER_FREE_TIMEOUT", 60.0)
+        program = student_process(_program(tmp_path / "freed", "print('ran')\n"), [],
+                                  Limits(), domain=domain, mode="user", course=COURSE)
+        program.start()
+        try:
+            assert program.wait(60.0) == 0
+        finally:
+            program.stop()
+        assert program.output_text() == "ran\n"
+        assert user_tasks(uid) == 0
+    finally:
+        for process in (leftover, holder):
+            process.kill()
+            process.wait()

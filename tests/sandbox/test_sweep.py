@@ -13,6 +13,7 @@ from pathlib import Path
 
 import pytest
 
+from autograder.sandbox.contained.launcher import user_tasks
 from autograder.sandbox.isolation import student_uid
 from autograder.sandbox.sweep import (
     STUDENT_UID_BASE,
@@ -58,6 +59,34 @@ def test_the_sweep_ends_a_users_processes_its_ipc_and_its_scratch_files(tmp_path
     assert user_processes(uid) == []
     assert user_ipc(uid) == []
     assert not Path(f"/dev/shm/autograder-sweep-test-{uid}").exists()
+
+
+@root_only
+def test_the_sweep_ends_once_the_users_zombies_are_reaped_too():
+    """A program that forked 60 children that ended at once and were never reaped: killed,
+    its children are orphans the machine's init reaps in its own time, each counted against
+    the user's RLIMIT_NPROC meanwhile. The sweep returns once none is counted (but the
+    program itself, the caller's child and the caller's to reap)."""
+    uid = student_uid(229)  # a domain no grading reserves
+    code = ("import os, time\n"
+            "for _ in range(60):\n"
+            "    if os.fork() == 0:\n"
+            "        os._exit(0)\n"
+            "print('forked', flush=True)\n"
+            "time.sleep(600)\n")
+    program = subprocess.Popen(["setpriv", f"--reuid={uid}", f"--regid={uid}",
+                                "--clear-groups", sys.executable, "-I", "-c", code],
+                               cwd="/", stdout=subprocess.PIPE, text=True)
+    try:
+        assert program.stdout is not None and program.stdout.readline() == "forked\n"
+        assert user_tasks(uid) == 61
+        assert sweep_user(uid)
+        assert user_processes(uid) == []
+        assert user_tasks(uid) == 1  # the program's zombie, ours to reap
+    finally:
+        program.kill()
+        program.wait()
+    assert user_tasks(uid) == 0
 
 
 def _status(proc: Path, pid: int, uid: int, state: str) -> None:
