@@ -12,6 +12,8 @@ pipe handed over, then :func:`~.launcher.contain`: cgroups, limits, and in
 strict isolation the mount namespace and the student's user) and then runs the program as
 ``python SCRIPT ARGS...`` would, as the interpreter's main program.  The zygote tells the
 grader each child's pid, and its wait status and peak resident size once it has exited.
+It is its programs' subreaper: what they leave when they end (a fork bomb's children) is
+the zygote's to reap, and is reported the same way.
 
 The zygote holds nothing of the grader's: it is started from a clean environment, never
 sees the course's tests, the report's key or the grader's files, and is single-threaded
@@ -25,6 +27,7 @@ from __future__ import annotations
 
 import array
 import contextlib
+import ctypes
 import json
 import os
 import select
@@ -54,6 +57,7 @@ STARTUP_VARIABLES = (
     "PYTHONIOENCODING", "LANG", "LC_ALL", "LC_CTYPE", "MALLOC_ARENA_MAX", "LD_LIBRARY_PATH",
 )
 MAX_MESSAGE = 1 << 20
+PR_SET_CHILD_SUBREAPER = 36
 
 
 # -- the zygote ----------------------------------------------------------------------
@@ -71,6 +75,11 @@ def serve(fd: int) -> tuple[str, list[str]]:
     """Serve the grader until its socket closes (then exit); return only in a forked child,
     contained, with the script to run and its arguments."""
     sock = socket.socket(fileno=fd)
+    # The orphans of the programs forked here (a fork bomb's children, once it is killed)
+    # become ours, reaped at once below, instead of waiting for the machine's init: each
+    # counts against its user's RLIMIT_NPROC until reaped (see autograder.sandbox.sweep).
+    with contextlib.suppress(OSError, AttributeError):
+        ctypes.CDLL(None, use_errno=True).prctl(PR_SET_CHILD_SUBREAPER, 1, 0, 0, 0)
     _warm()
     fork = fork_with_hooks()
     wake_read, wake_write = os.pipe()
@@ -377,6 +386,9 @@ class Zygote:
                             int(message["status"]))
                         self.peak_kb = max(self.peak_kb, int(message.get("maxrss_kb", 0)))
                     else:
+                        # A pid the zygote forks again (after an orphan's of that pid was
+                        # reported, or an earlier program's) starts with no status.
+                        self._statuses.pop(int(message.get("pid", -1)), None)
                         self._replies.append(message)
                     self._lock.notify_all()
         except (OSError, ValueError):

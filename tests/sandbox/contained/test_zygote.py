@@ -251,3 +251,42 @@ def test_the_zygotes_descriptors_are_closed_before_lttngs_threads_start_again(
         os.close(report_read)
         os.waitpid(pid, 0)
     assert report == "True False", "the hook's descriptor, then the zygote's leftover"
+
+
+@pytest.mark.usefixtures("fresh_zygotes")
+def test_a_programs_orphans_are_the_zygotes_to_reap(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A child left by a program that ended (a fork bomb's, once it is killed) goes to the
+    zygote, which reaps it at once, instead of to the machine's init: until reaped it
+    counts against its user's RLIMIT_NPROC (tests/sandbox/test_user_budget.py). The zygote
+    reports it as it reports its programs."""
+    monkeypatch.setenv("AUTOGRADER_ZYGOTE", "1")
+    staged = tmp_path / "staged"
+    staged.mkdir()
+    (staged / "prog.py").write_text(
+        "import os, sys, time\n"
+        "if os.fork() == 0:\n"
+        "    parent = os.getppid()\n"
+        "    end = time.monotonic() + 60\n"
+        "    while os.getppid() == parent and time.monotonic() < end:\n"
+        "        time.sleep(0.01)\n"
+        "    print('orphan', os.getpid(), os.getppid(), flush=True)\n"
+        "    os._exit(0)\n"
+        "print('parent', os.getpid(), flush=True)\n")
+    program = student_process(staged / "prog.py", [], Limits(), domain=7, strict=False,
+                              course=ROOT)
+    program.start()
+    try:
+        assert isinstance(program.popen, ForkedProcess)
+        (zygote,) = zygotes()
+        assert program.wait(WALL) == 0
+        end = time.monotonic() + WALL
+        while "orphan" not in program.output_text():
+            assert time.monotonic() < end, program.output_text()
+            time.sleep(0.01)
+        orphan, adopter = (int(word) for word in
+                           program.output_text().split("orphan ", 1)[1].split()[:2])
+        assert adopter == zygote.process.pid
+        assert zygote.status(orphan, WALL) == 0  # reaped by the zygote, and reported
+    finally:
+        program.stop()
