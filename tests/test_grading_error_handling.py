@@ -28,16 +28,24 @@ def test_a_dead_or_silent_node_is_named_as_such(graded):
     assert "ValueError" in message or "Traceback" in message
 
 
-def test_shutdown_failure_shows_the_traceback(graded):
+def test_shutdown_failure_names_the_trial_and_shows_the_traceback_if_any(graded):
     """The failure names the trial that went wrong and shows the student's traceback.
 
-    Which trial fails is not fixed: the naive design races rclpy's own signal thread,
-    and now and then (1 in 30 under load, measured) its publish in `finally` wins.
+    Which failure comes is not fixed: the naive design races rclpy's own signal thread.
+    Mostly the context is shut down first and the publish in `finally` raises (the
+    traceback); now and then (1 in 30 under load, measured; once in three runs of this
+    module) the interrupt comes first, the stop is published and lost as the process ends
+    without waiting for it to be acknowledged, and the failure is the last command driving
+    on, with no traceback to show. Both say how to fix it
+    (tests/submissions/error_handling/traceback_on_sigint/expect.yaml).
     """
     by_name = {t.name: t for t in graded["traceback_on_sigint"].tests}
     message = by_name["test_clean_exit_on_sigint"].message
     assert re.search(r"After SIGINT \(trial [123] of 3\)", message), message
-    assert "Traceback" in message
+    if "the last command on cmd_vel was" in message:
+        assert "linear.x=0.2" in message, message
+    else:
+        assert "Traceback" in message, message
 
 
 def test_driving_into_what_is_ahead_is_told_which_beam_is_front(graded):
