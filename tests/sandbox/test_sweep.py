@@ -61,6 +61,7 @@ def test_the_sweep_ends_a_users_processes_its_ipc_and_its_scratch_files(tmp_path
     assert not Path(f"/dev/shm/autograder-sweep-test-{uid}").exists()
 
 
+@pytest.mark.slow  # the machine's init reaps in its own time: 1.5 s here
 @root_only
 def test_the_sweep_ends_once_the_users_zombies_are_reaped_too():
     """A program that forked 60 children that ended at once and were never reaped: killed,
