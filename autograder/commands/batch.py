@@ -110,9 +110,12 @@ def run_batch(entries: dict[str, Path], grade_one: Callable[[Path], RunResult], 
     limit = 1 if chooser is not None else max(1, int(jobs))  # type: ignore[arg-type]
     running: set[Future[tuple[RunResult, float]]] = set()
     workers = len(queue) if chooser is not None else limit
+    started = getattr(chooser, "started", None)  # told of each start, where it listens
     with ThreadPoolExecutor(max_workers=max(1, workers)) as pool:
         while queue or running:
             while queue and len(running) < limit:
+                if started is not None:
+                    started()
                 running.add(pool.submit(work, *queue.popleft()))
             done, _pending = wait(running, return_when=FIRST_COMPLETED)
             at_once = len(running)

@@ -254,32 +254,69 @@ def starved(result: RunResult) -> bool:
 
 
 class AutoChooser:
-    """``--jobs auto`` for ``run_batch``: told of each grading as it ends, it gives the
-    concurrency for the rest (see :func:`decide`) and tells ``report`` when it changes."""
+    """``--jobs auto`` for ``run_batch``: told of each grading as it starts and ends, it
+    gives the concurrency for the rest (see :func:`decide`) and tells ``report`` when it
+    changes.
+
+    The batch's CPU shows in this process's counters as its gradings' processes end (a
+    module's child at the end of that module), whichever grading they were part of, so
+    each reading's growth is shared among the gradings that ran since the last reading, in
+    proportion to how long each ran in that time: a grading's CPU is what it was dealt
+    while it ran. (Counting all of it as the grading that ended read seven gradings' CPU as
+    one's, and the choice swung from 7 to 2 and back, `benchmarks/RESULTS.md`.) Without
+    ``started`` calls, what grew since the last end is the ending grading's."""
 
     def __init__(self, report: Callable[[str], None] | None = None,
                  cores: Callable[[], float] | None = None,
                  memory_mb: Callable[[], float] | None = None,
-                 cpu: Callable[[], float] | None = None) -> None:
+                 cpu: Callable[[], float] | None = None,
+                 clock: Callable[[], float] = time.monotonic) -> None:
         self._report = report
         self._cores = cores or machine_cores
         self._memory_mb = memory_mb or machine_memory_mb
         self._cpu = cpu or _cpu_seconds
+        self._clock = clock
         self._lock = threading.Lock()
         self._last_cpu = self._cpu()
+        self._last_read = clock()
+        self._running: list[list[float]] = []  # [started, CPU seconds dealt so far]
         self.tally = Tally()
         self.jobs: int | None = None
+
+    def _deal(self) -> float:
+        """Share the CPU grown since the last reading among the running gradings by the
+        time each ran since then; what grew (also when none was running)."""
+        now, cpu = self._clock(), self._cpu()
+        grown = cpu - self._last_cpu
+        spans = [now - max(started, self._last_read) for started, _dealt in self._running]
+        total = sum(spans)
+        for grading, span in zip(self._running, spans, strict=True):
+            grading[1] += grown * span / total if total > 0 else grown / len(self._running)
+        self._last_cpu, self._last_read = cpu, now
+        return grown
+
+    def started(self) -> None:
+        """A grading starts now."""
+        with self._lock:
+            self._deal()
+            self._running.append([self._clock(), 0.0])
 
     def __call__(self, wall: float, result: RunResult, at_once: int, students: int) -> int:
         """One grading ended after ``wall`` seconds with ``result``, ``at_once``
         running then (itself included), ``students`` left to grade (running or not)."""
         with self._lock:
-            now = self._cpu()
+            grown = self._deal()
+            if self._running:  # the one that started closest to ``wall`` ago
+                began = self._clock() - wall
+                ended = min(self._running, key=lambda grading: abs(grading[0] - began))
+                self._running.remove(ended)
+                cpu_seconds = ended[1]
+            else:
+                cpu_seconds = grown
             memory = result.memory
-            self.tally = self.tally.add(wall=wall, cpu_seconds=now - self._last_cpu,
+            self.tally = self.tally.add(wall=wall, cpu_seconds=cpu_seconds,
                                         footprint_mb=memory and memory.footprint_mb,
                                         strained=starved(result), at_once=at_once)
-            self._last_cpu = now
             choice = decide(self.tally, cores=self._cores(), memory_mb=self._memory_mb(),
                             students=max(1, students))
             if choice.jobs != self.jobs and self._report is not None:

@@ -173,6 +173,32 @@ def test_the_chooser_decides_again_and_says_so_only_when_the_number_changes() ->
     assert "longer than the world holds its clock" in said[-1]
 
 
+def test_the_chooser_deals_the_cpu_among_the_gradings_that_ran_by_their_time() -> None:
+    """The batch's CPU grows as gradings' processes end, whichever grading they were part
+    of: what grew since the last reading is dealt among the gradings that ran meanwhile,
+    by how long each ran then, so the first to end among five is not charged for all."""
+    now, cpu = [0.0], [0.0]
+    chooser = AutoChooser(cores=lambda: 2.0, memory_mb=lambda: 8000.0,
+                          cpu=lambda: cpu[0], clock=lambda: now[0])
+    plain = _result(3)
+    chooser.started()                   # the first, alone: 5 CPU-s in 10 s
+    now[0], cpu[0] = 10.0, 5.0
+    assert chooser(10.0, plain, 1, 9) == 4  # 0.5 of a core: the ceiling, 2 a core
+    for _ in range(4):
+        chooser.started()               # four at once from t=10
+    now[0], cpu[0] = 15.0, 15.0         # 10 CPU-s more: the four ran 5 s each
+    chooser.started()                   # a fifth from t=15
+    now[0], cpu[0] = 20.0, 30.0         # 15 more: the five ran 5 s each
+    assert chooser(10.0, plain, 5, 8) == 4
+    assert chooser.tally.cpu_seconds == pytest.approx(5.0 + 10.0 / 4 + 15.0 / 5)
+    assert chooser.tally.cpu_share == pytest.approx((5.0 + 5.5) / 2 / 10)
+    now[0], cpu[0] = 22.0, 38.0         # 8 more: the four left ran 2 s each
+    assert chooser(7.0, plain, 4, 7) == 4  # the fifth (7 s ago): 3 + 2
+    assert chooser.tally.cpu_seconds == pytest.approx(10.5 + 15.0 / 5 + 8.0 / 4)
+    # Counted as the old way, the second grading's CPU would be the 25 CPU-s that grew
+    # while it ran: a share of 1.5, and 2 at once instead of 4.
+
+
 def test_auto_grades_the_first_alone_then_chooses_as_each_ends(tmp_path) -> None:
     entries = {f"s{i}": tmp_path / f"s{i}" for i in range(5)}
     asked = []
