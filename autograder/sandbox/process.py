@@ -214,6 +214,16 @@ def forked_peak_mb() -> float:
 # user's processes are swept once the last of its programs here is reaped.
 _users: dict[int, set[int]] = {}
 _users_lock = threading.Lock()
+# One lock a user, held while its first program here frees the user and starts, and while
+# its last one's sweep runs: a sweep never meets a program of the user that is starting.
+_user_locks: dict[int, threading.Lock] = {}
+
+
+def _user_lock(uid: int | None) -> contextlib.AbstractContextManager[object]:
+    if uid is None:
+        return contextlib.nullcontext()
+    with _users_lock:
+        return _user_locks.setdefault(uid, threading.Lock())
 
 
 def _user_done(process: StudentProcess) -> bool:
@@ -337,21 +347,22 @@ class StudentProcess:
         launcher_env["PYTHONPATH"] = os.pathsep.join(
             p for p in (PACKAGE_PARENT, self.env.get("PYTHONPATH"))
             if p)
-        if self.uid is not None:
-            with _users_lock:
-                first = not _users.get(self.uid)
-                _users.setdefault(self.uid, set()).add(id(self))
-            if first and not kill_user(self.uid, USER_FREE_TIMEOUT):
-                _user_done(self)
-                raise LaunchFailed("user", f"user {self.uid} still has processes of an "
-                                   "earlier program that the machine has not reaped")
-        with self.gate if self.gate is not None else contextlib.nullcontext():
-            started = (self._fork(spec, args, launcher_env)
-                       or self._exec(spec, args, launcher_env))
-            self.popen, status_read = started
-            self.started_at = time.monotonic()
-            if self.on_spawn is not None:
-                self.on_spawn()
+        with _user_lock(self.uid):
+            if self.uid is not None:
+                with _users_lock:
+                    first = not _users.get(self.uid)
+                    _users.setdefault(self.uid, set()).add(id(self))
+                if first and not kill_user(self.uid, USER_FREE_TIMEOUT):
+                    _user_done(self)
+                    raise LaunchFailed("user", f"user {self.uid} still has processes of "
+                                       "an earlier program that the machine has not reaped")
+            with self.gate if self.gate is not None else contextlib.nullcontext():
+                started = (self._fork(spec, args, launcher_env)
+                           or self._exec(spec, args, launcher_env))
+                self.popen, status_read = started
+                self.started_at = time.monotonic()
+                if self.on_spawn is not None:
+                    self.on_spawn()
         self._reader = threading.Thread(target=self._read, daemon=True, name="student-output")
         self._reader.start()
         try:
@@ -482,8 +493,9 @@ class StudentProcess:
         if self.cgroup is not None:
             self.cgroup.kill_all()
             self.cgroup.remove()
-        if self.uid is not None and _user_done(self):
-            sweep_user(self.uid)  # what left the group and the cgroup, or had no cgroup
+        with _user_lock(self.uid):
+            if self.uid is not None and _user_done(self):
+                sweep_user(self.uid)  # what left the group and the cgroup, or had no cgroup
         if self._reader is not None:
             self._reader.join(2.0)
 

@@ -352,3 +352,50 @@ def test_a_user_an_earlier_program_still_holds_is_freed_or_the_launch_is_ours(
         for process in (leftover, holder):
             process.kill()
             process.wait()
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(os.geteuid() != 0 or not shutil.which("setpriv"),
+                    reason="needs root and setpriv to act as a student's user")
+def test_a_program_that_starts_while_its_users_sweep_runs_waits_for_the_sweep(
+        tmp_path, monkeypatch):
+    """The sweep after a user's last program ends every process of the user: a program of
+    that user starting meanwhile (the next test's) would be swept with it. It waits for
+    the sweep instead, and runs."""
+    import threading
+
+    from autograder.sandbox import process as process_module
+    from autograder.sandbox.domains import hold_domain
+
+    in_sweep, release, spawned = threading.Event(), threading.Event(), threading.Event()
+    sweep = process_module.sweep_user
+
+    def held_sweep(uid: int) -> bool:
+        in_sweep.set()
+        release.wait(60.0)
+        return sweep(uid)
+
+    with hold_domain() as lock:
+        first = student_process(_program(tmp_path / "first", "import time\ntime.sleep(60)\n"),
+                                [], Limits(), domain=lock.domain, mode="user", course=COURSE)
+        first.start()
+        monkeypatch.setattr(process_module, "sweep_user", held_sweep)
+        stopping = threading.Thread(target=first.stop)
+        stopping.start()
+        assert in_sweep.wait(60.0)
+        second = student_process(_program(tmp_path / "second", "print('ran')\n"), [],
+                                 Limits(), domain=lock.domain, mode="user", course=COURSE)
+        second.on_spawn = spawned.set
+        starting = threading.Thread(target=second.start)
+        starting.start()
+        # While the sweep is held the second program must not start; 2 s is ample for a
+        # start here (about 0.3 s), so one that did not wait would have started by then.
+        assert not spawned.wait(2.0)
+        release.set()
+        stopping.join(60.0)
+        starting.join(60.0)
+        try:
+            assert second.wait(60.0) == 0
+        finally:
+            second.stop()
+        assert second.output_text() == "ran\n"
