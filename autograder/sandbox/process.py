@@ -354,6 +354,7 @@ class StudentProcess:
                     _users.setdefault(self.uid, set()).add(id(self))
                 if first and not kill_user(self.uid, USER_FREE_TIMEOUT):
                     _user_done(self)
+                    self.cgroup.remove()  # made above, and nothing joined it
                     raise LaunchFailed("user", f"user {self.uid} still has processes of "
                                        "an earlier program that the machine has not reaped")
             with self.gate if self.gate is not None else contextlib.nullcontext():
