@@ -384,6 +384,12 @@ class SimBridge:
         self._cmd = (twist.linear.x, twist.angular.z)
         self._tap("/cmd_vel", msg, self.world.time)
 
+    def receiving(self) -> bool:
+        """Whether this process's middleware still has messages to take in: a receive
+        thread runs or waits for a CPU, or the kernel holds packets for no socket yet
+        (:class:`sim.procstate.Receiving`; the probe's participant is in this process too)."""
+        return self._receiving()
+
     def take_commands(self) -> int:
         """Take every /cmd_vel message our middleware holds, oldest first, as each tick
         does before it steps (no executor takes them); return how many there were.  The

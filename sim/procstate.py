@@ -48,6 +48,15 @@ def _thread_running(stat: bytes) -> bool:
     return stat[end + 2:end + 3] == b"R"
 
 
+def thread_busy(tid: int) -> bool:
+    """True if thread ``tid`` of this process is running or waits for a CPU; False if it
+    sleeps or is gone."""
+    try:
+        return _thread_running(_read_file(f"/proc/self/task/{tid}/stat", 4096))
+    except (OSError, ValueError):
+        return False
+
+
 # Each watched thread's ``stat`` and ``schedstat``, kept open and read with ``pread``: the
 # pacing reads a busy process every 0.5 ms, and opening two files per thread each time is
 # most of the kernel's share of the world's CPU (``benchmarks/RESULTS.md``). pid -> tid ->

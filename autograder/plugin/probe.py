@@ -27,7 +27,7 @@ from autograder.i18n import _
 from autograder.plugin.msgtypes import CHECK_EVERY, TypeWatch, watch_world_cmd_vel
 from sim.bag import Tap
 from sim.msgdefs import type_name
-from sim.procstate import UsageTally
+from sim.procstate import UsageTally, thread_busy
 
 M = TypeVar("M")
 
@@ -84,18 +84,29 @@ class Inbox(Generic[M]):
                 self._lock.wait(left)
             return True
 
-    def wait_quiet(self, quiet: float, limit: float) -> bool:
-        """Wait until no message has arrived for ``quiet`` wall seconds; False if messages
-        still came after ``limit`` seconds."""
+    def wait_quiet(self, quiet: float, limit: float,
+                   delivering: Callable[[], bool] | None = None) -> bool:
+        """Wait until no message has arrived for ``quiet`` wall seconds and, where given,
+        ``delivering()`` (what hands this inbox its messages still has work) read False
+        twice at its end; False if that did not happen within ``limit`` seconds.
+
+        Without ``delivering``, quiet only means that nothing came: on a crowded machine
+        the thread that delivers may just have had no CPU for that long."""
         end = time.monotonic() + limit
-        with self._lock:
-            while True:
+        while True:
+            with self._lock:
                 seen, now = self._arrivals, time.monotonic()
                 if now >= end:
                     return False
                 self._lock.wait(min(quiet, end - now))
-                if self._arrivals == seen and time.monotonic() - now >= quiet - 1e-3:
-                    return True
+                if self._arrivals != seen or time.monotonic() - now < quiet - 1e-3:
+                    continue
+            # Read outside the lock: a delivering thread waiting for it would read idle.
+            # Twice: one reading is one thread after another, not one instant.
+            if delivering is None or not (delivering() or delivering()):
+                with self._lock:
+                    if self._arrivals == seen:
+                        return True
 
     @property
     def items(self) -> list[tuple[float, M]]:
@@ -260,10 +271,21 @@ class Probe:
 
     def settle(self, inbox: Inbox[Any], quiet: float = 0.05, limit: float = 1.0) -> None:
         """Hold simulation time until nothing new has reached ``inbox`` for ``quiet`` wall
-        seconds (at most ``limit``): then it holds all the node sent so far, however late a
-        busy machine delivers it (the world waits for the node, not for the probe)."""
+        seconds and nothing is on its way in (:meth:`delivering`), at most ``limit``: then
+        it holds all the node sent so far, however late a busy machine delivers it (the
+        world waits for the node, not for the probe)."""
         with self.world.held():
-            inbox.wait_quiet(quiet, limit)
+            inbox.wait_quiet(quiet, limit, self.delivering)
+
+    def delivering(self) -> bool:
+        """Whether messages may still be on their way into this probe's inboxes: its
+        executor's thread runs or waits for a CPU (a crowded machine may leave it queued
+        longer than any quiet spell), or this process's middleware is taking messages in."""
+        tid = self._thread.native_id
+        if tid is not None and self._thread.is_alive() and thread_busy(tid):
+            return True
+        receiving = getattr(self.world, "receiving", None)
+        return bool(receiving is not None and receiving())
 
     def wait_sim(self, seconds: float) -> None:
         """Let ``seconds`` of simulation time pass (the world keeps running meanwhile)."""

@@ -49,6 +49,38 @@ def test_wait_quiet_returns_once_nothing_arrives():
     assert inbox.wait_quiet(quiet=0.02, limit=5.0)
 
 
+def test_wait_quiet_waits_while_a_message_is_still_on_its_way():
+    """Nothing arriving for a while is not enough while what delivers still has work (a
+    crowded machine can leave the probe's executor without a CPU for longer than any quiet
+    spell): the late message is in when the wait returns."""
+    inbox: Inbox[int] = Inbox("/cmd_vel")
+    inbox.add(0.0, 1)
+    on_its_way, go = threading.Event(), threading.Event()
+    on_its_way.set()
+    asked = []
+
+    def delivering() -> bool:
+        asked.append(on_its_way.is_set())
+        if len(asked) == 3:  # asked after quiet spells: only now does it come
+            go.set()
+        return on_its_way.is_set()
+
+    def deliver() -> None:
+        go.wait()
+        inbox.add(0.0, 2)
+        on_its_way.clear()
+
+    deliverer = threading.Thread(target=deliver)
+    deliverer.start()
+    try:
+        assert inbox.wait_quiet(quiet=0.01, limit=30.0, delivering=delivering)
+    finally:
+        go.set()
+        deliverer.join()
+    assert inbox.messages == [1, 2]
+    assert asked[:3] == [True, True, True] and asked[-2:] == [False, False]
+
+
 def test_wait_quiet_is_not_fooled_by_a_flood_even_past_the_limit(monkeypatch):
     monkeypatch.setattr(Inbox, "LIMIT", 10)  # dropped messages still count as arrivals
     inbox: Inbox[int] = Inbox("/cmd_vel")

@@ -6,6 +6,7 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 from collections.abc import Iterator
 
@@ -20,6 +21,7 @@ from sim.procstate import (
     family_usage,
     process_busy,
     read_process_state,
+    thread_busy,
 )
 
 WALL = 20.0
@@ -103,6 +105,56 @@ def test_a_starved_process_is_busy_but_gets_no_cpu() -> None:
     assert all(s.busy for s in samples)
     # At this rate it would not use its CPU budget within the 2 s cap of a hold.
     assert used < DEFAULT_CPU_BUDGET * 1e9 / 4, used
+
+
+def test_a_thread_of_ours_that_waits_for_a_cpu_reads_busy_and_one_that_sleeps_idle() -> None:
+    """thread_busy: a thread of this process kept from the CPU (a crowded machine) reads
+    busy in every reading, as the probe's executor must when it has messages to deliver;
+    one waiting for an event reads idle, and a thread that is gone reads idle."""
+    import hashlib
+
+    stop, sleeping = threading.Event(), threading.Event()
+    tids: dict[str, int] = {}
+    started = threading.Barrier(3)
+
+    def crunch() -> None:  # hashing releases the GIL: the thread stays runnable
+        tids["crunching"] = threading.get_native_id()
+        os.sched_setaffinity(0, {0})  # this thread only, beside the hog, at the lowest
+        os.setpriority(os.PRIO_PROCESS, threading.get_native_id(), 19)
+        started.wait()
+        block, digest = bytes(1 << 22), hashlib.sha256()
+        while not stop.is_set():
+            digest.update(block)
+
+    hog = _spinning()
+    os.sched_setaffinity(hog.pid, {0})
+    cruncher = threading.Thread(target=crunch)
+
+    def sleep() -> None:
+        tids["waiting"] = threading.get_native_id()
+        started.wait()
+        sleeping.wait()
+
+    sleeper = threading.Thread(target=sleep)
+    cruncher.start()
+    sleeper.start()
+    try:
+        started.wait(WALL)
+        crunching, waiting = tids["crunching"], tids["waiting"]
+        readings = []
+        for _ in range(50):
+            readings.append((thread_busy(crunching), thread_busy(waiting)))
+            time.sleep(0.01)
+    finally:
+        stop.set()
+        sleeping.set()
+        cruncher.join()
+        sleeper.join()
+        hog.kill()
+        hog.wait()
+    assert all(busy for busy, _ in readings)
+    assert not any(idle for _, idle in readings)
+    assert not thread_busy(crunching)  # gone
 
 
 # A process whose thread count changes on command: a line "+" starts a thread that blocks,

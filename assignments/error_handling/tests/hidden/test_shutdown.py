@@ -82,7 +82,7 @@ def _trial(probe, world, start_node, sig: signal.Signals, trial: int) -> None:
     # The process has ended: what it sent is on its way, and reaches us in wall time
     # (simulation time now runs freely). Wait for the stop, then until nothing more comes.
     commands.wait_until(stopped, ARRIVE_WITHIN)
-    commands.wait_quiet(STRAGGLERS, ARRIVE_WITHIN)
+    commands.wait_quiet(STRAGGLERS, ARRIVE_WITHIN, probe.delivering)
     if not stopped():
         last = commands.messages[-1]
         raise StudentFailure(
