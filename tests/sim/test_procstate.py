@@ -110,7 +110,7 @@ def test_a_starved_process_is_busy_but_gets_no_cpu() -> None:
 def test_a_thread_of_ours_that_waits_for_a_cpu_reads_busy_and_one_that_sleeps_idle() -> None:
     """thread_busy: a thread of this process kept from the CPU (a crowded machine) reads
     busy in every reading, as the probe's executor must when it has messages to deliver;
-    one waiting for an event reads idle, and a thread that is gone reads idle."""
+    one blocked on an event reads idle, and a thread that is gone reads idle."""
     import hashlib
 
     stop, sleeping = threading.Event(), threading.Event()
@@ -126,34 +126,41 @@ def test_a_thread_of_ours_that_waits_for_a_cpu_reads_busy_and_one_that_sleeps_id
         while not stop.is_set():
             digest.update(block)
 
-    hog = _spinning()
-    os.sched_setaffinity(hog.pid, {0})
-    cruncher = threading.Thread(target=crunch)
-
     def sleep() -> None:
         tids["waiting"] = threading.get_native_id()
         started.wait()
         sleeping.wait()
 
-    sleeper = threading.Thread(target=sleep)
+    hog = _spinning()
+    os.sched_setaffinity(hog.pid, {0})
+    cruncher, sleeper = threading.Thread(target=crunch), threading.Thread(target=sleep)
     cruncher.start()
     sleeper.start()
     try:
         started.wait(WALL)
         crunching, waiting = tids["crunching"], tids["waiting"]
-        readings = []
+        busy = []
         for _ in range(50):
-            readings.append((thread_busy(crunching), thread_busy(waiting)))
+            busy.append(thread_busy(crunching))
             time.sleep(0.01)
     finally:
         stop.set()
-        sleeping.set()
         cruncher.join()
-        sleeper.join()
         hog.kill()
         hog.wait()
-    assert all(busy for busy, _ in readings)
-    assert not any(idle for _, idle in readings)
+    # Read once the cruncher is gone: starved while it held the GIL, it could keep the
+    # sleeper waiting for the GIL on its way into its wait, woken every 5 ms to ask again.
+    try:
+        assert _poll(lambda: not thread_busy(waiting))  # in its wait: it stays there
+        idle = []
+        for _ in range(20):
+            idle.append(not thread_busy(waiting))
+            time.sleep(0.01)
+    finally:
+        sleeping.set()
+        sleeper.join()
+    assert all(busy), busy
+    assert all(idle), idle
     assert not thread_busy(crunching)  # gone
 
 
