@@ -20,9 +20,11 @@ design notes, "Pacing"):
   tick and is idle (two readings agreeing: one reading is thread after thread, not an
   instant), or has used its CPU share since the tick (``cpu_budget`` and what it banked
   in its reserve), so a process that waits for a CPU holds sim time back and one that
-  busy-loops only slows it.  A process hears a tick when its CPU time grows or it
-  runs after the tick went out; one that heard the tick before is waited for to hear this
-  one, up to ``hear_timeout`` while the kernel holds no packet it has not yet delivered.
+  busy-loops only slows it.  A process hears a tick when its own threads (not its
+  middleware's, which take ``/clock`` in whether or not the node's executor wakes for
+  it) use CPU or run after the tick went out; one that heard the tick before is waited
+  for to hear this one, up to ``hear_timeout`` while the kernel holds no packet it has
+  not yet delivered.
   Then the world's own middleware must have taken in what the processes sent, up to
   ``receive_timeout``.  ``hold_cap`` ends a hold, not counting the time in which every busy
   watched process waited for a CPU; ``hold_limit`` ends it whatever the machine.
@@ -190,7 +192,8 @@ class Pacer:
         # Holds that, the processes done, waited for the world to take in what they sent.
         self.receipts_awaited = 0
         self._reserve: dict[int, float] = {}  # CPU seconds each watched process has banked
-        self._before: dict[int, int] = {}  # CPU ns of each watched process before a tick
+        # Each watched process as read just before a tick went out.
+        self._before: dict[int, ProcessState] = {}
         self._heard: set[int] = set()  # those seen to hear the last tick during its hold
         self._listening: set[int] = set()  # those that heard the tick before
         self._closing: set[int] = set()  # those being stopped: never waited for to hear
@@ -290,7 +293,7 @@ class Pacer:
 
     def about_to_publish(self) -> None:
         """Read the watched processes' CPU time just before a tick goes out: a process
-        whose CPU time grows from here on has heard it.  Also judge, over the whole time
+        whose own threads use CPU from here on has heard it.  Also judge, over the whole time
         since the tick before, which of them heard that one: the next hold waits for
         those to hear this tick (call with :attr:`condition` held)."""
         states = {pid: self._read(pid) for pid in self._pids}
@@ -299,12 +302,12 @@ class Pacer:
                 continue
             if pid in self._closing:
                 continue
-            if (pid in self._heard or not state.exists or state.busy
-                    or state.cpu_ns > self._before[pid]):
+            if (pid in self._heard or not state.exists or state.own_busy
+                    or state.own_cpu_ns > self._before[pid].own_cpu_ns):
                 self._listening.add(pid)
             else:
                 self._listening.discard(pid)
-        self._before = {pid: state.cpu_ns for pid, state in states.items()}
+        self._before = states
         self._heard = set()
 
     # -- measuring ------------------------------------------------------------------
@@ -405,10 +408,12 @@ class Pacer:
             self._clock.sleep(first - now)
         # Without a reading from before the tick (a process watched since), the budget
         # counts from now and the process counts as having heard the tick.
-        baseline = {pid: before[pid] if pid in before else self._read(pid).cpu_ns
-                    for pid in pids}
+        start = {pid: before[pid] if pid in before else self._read(pid) for pid in pids}
+        baseline = {pid: state.cpu_ns for pid, state in start.items()}
         budget_ns = int(policy.cpu_budget * 1e9)
-        return _Hold(published=published, baseline=baseline, reserve=reserve,
+        return _Hold(published=published, baseline=baseline,
+                     own_baseline={pid: state.own_cpu_ns for pid, state in start.items()},
+                     reserve=reserve,
                      share_ns={pid: budget_ns + int(reserve[pid] * 1e9) for pid in pids},
                      heard={pid: pid not in before for pid in pids}, listening=listening,
                      cap=published + policy.hold_cap)
@@ -475,6 +480,7 @@ class _Hold:
 
     published: float
     baseline: dict[int, int]  # CPU ns of each process when the tick went out
+    own_baseline: dict[int, int]  # CPU ns of its own threads (not its middleware's) then
     reserve: dict[int, float]  # CPU seconds each had banked
     share_ns: dict[int, int]  # CPU ns each may use before the tick goes on without it
     heard: dict[int, bool]  # whether each has heard the tick
@@ -489,8 +495,9 @@ class _Hold:
         """Take a reading; True if every busy process waited for a CPU since the last."""
         previous, self.states = self.states, states
         for pid, state in states.items():
-            self.heard[pid] = self.heard[pid] or (not state.exists or state.busy
-                                                  or state.cpu_ns > self.baseline[pid])
+            self.heard[pid] = self.heard[pid] or (
+                not state.exists or state.own_busy
+                or state.own_cpu_ns > self.own_baseline[pid])
         # A reading of a process is one thread after another, not one instant: a thread
         # woken by another after we read it, the other gone to sleep before we read it,
         # reads idle.  It will have run, or be runnable, by the next reading.

@@ -9,6 +9,12 @@ Two facts per process, summed over its threads:
   ``/proc/<pid>/task/*/schedstat``).  Told apart from *busy*, it separates a process that
   computes (its CPU time grows) from one that only waits for a CPU (it does not).
 
+Both are also read over the program's **own** threads alone (``own_busy``,
+``own_cpu_ns``): every thread but its middleware's, which Fast DDS names ``dds.*``.
+A node's middleware takes a ``/clock`` sample in on its own threads whether or not
+the node's executor wakes for it, so only the program's own threads say that the node
+has heard a tick.
+
 A process that is gone reads as idle with no CPU time and ``exists`` false: it has
 nothing left to react to.
 
@@ -27,11 +33,21 @@ from dataclasses import dataclass
 
 @dataclass(frozen=True)
 class ProcessState:
-    """One reading of a process: is any thread running or runnable, CPU ns used so far."""
+    """One reading of a process: is any thread running or runnable, CPU ns used so far,
+    and both over its own threads alone (not its middleware's; when not given, the same
+    as over all its threads)."""
 
     busy: bool
     cpu_ns: int
     exists: bool = True
+    own_busy: bool = None  # type: ignore[assignment]  # None: as busy
+    own_cpu_ns: int = None  # type: ignore[assignment]  # None: as cpu_ns
+
+    def __post_init__(self) -> None:
+        if self.own_busy is None:
+            object.__setattr__(self, "own_busy", self.busy)
+        if self.own_cpu_ns is None:
+            object.__setattr__(self, "own_cpu_ns", self.cpu_ns)
 
 
 IDLE = ProcessState(busy=False, cpu_ns=0, exists=False)
@@ -41,11 +57,22 @@ ProcessReader = Callable[[int], ProcessState]
 """Reads the state of process ``pid`` (the pacing takes one, so tests can fake it)."""
 
 
+MIDDLEWARE_THREADS = b"dds."
+"""How Fast DDS (Jazzy's default middleware) begins the names of the threads it starts
+(``dds.udp.<port>``, ``dds.ev.<n>``, ``dds.shm.wdog``, ...): their work is the
+middleware's, not the program's."""
+
+
 def _thread_running(stat: bytes) -> bool:
     # The state follows the command name, which is in parentheses and may itself hold
     # spaces or parentheses: read it after the last ")".
     end = stat.rindex(b")")
     return stat[end + 2:end + 3] == b"R"
+
+
+def _middleware_thread(stat: bytes) -> bool:
+    """The thread's name (between the first "(" and the last ")") is Fast DDS's."""
+    return stat[stat.index(b"(") + 1:stat.rindex(b")")].startswith(MIDDLEWARE_THREADS)
 
 
 def thread_busy(tid: int) -> bool:
@@ -80,7 +107,7 @@ def read_process_state(pid: int) -> ProcessState:
         with _open_lock:
             _close_process(pid)
         return IDLE
-    busy, cpu = False, 0
+    busy, cpu, own_busy, own_cpu = False, 0, False, 0
     with _open_lock:
         files = _open.pop(pid, None) or {}
         _open[pid] = files  # last: the most recently read
@@ -91,22 +118,27 @@ def read_process_state(pid: int) -> ProcessState:
         for tid in tids:
             reading = _read_thread(base, tid, files)
             if reading is not None:
-                busy = busy or reading[0]
-                cpu += reading[1]
-    return ProcessState(busy, cpu)
+                running, used, middleware = reading
+                busy = busy or running
+                cpu += used
+                if not middleware:
+                    own_busy = own_busy or running
+                    own_cpu += used
+    return ProcessState(busy, cpu, own_busy=own_busy, own_cpu_ns=own_cpu)
 
 
 def _read_thread(base: str, tid: str, files: dict[str, tuple[int, int]],
-                 ) -> tuple[bool, int] | None:
-    """(running or runnable, CPU ns) of one thread through its kept files; None if it
-    cannot be read (it ended between listing and reading)."""
+                 ) -> tuple[bool, int, bool] | None:
+    """(running or runnable, CPU ns, the middleware's) of one thread through its kept
+    files; None if it cannot be read (it ended between listing and reading)."""
     for attempt in range(2):
         fds = files.get(tid)
         try:
             if fds is None:
                 fds = files[tid] = _open_thread(f"{base}{tid}/")
             stat = os.pread(fds[0], 4096, 0)
-            return _thread_running(stat), int(os.pread(fds[1], 128, 0).split()[0])
+            return (_thread_running(stat), int(os.pread(fds[1], 128, 0).split()[0]),
+                    _middleware_thread(stat))
         except (OSError, ValueError, IndexError):
             if tid in files:
                 _close(files.pop(tid))

@@ -47,7 +47,9 @@ class FakeProcess:
     It is busy until ``idle_at`` and meanwhile gets ``cpu_share`` seconds of CPU per wall
     second (1: it computes; 0: it is runnable but starved of a CPU).  It hears the ticks
     that went out from ``hears_from`` on: each reaches it ``delay`` after it went out, and
-    it then computes for ``reaction`` (at least a microsecond: a message costs some CPU)."""
+    it then computes for ``reaction`` (at least a microsecond: a message costs some CPU).
+    With ``middleware_delay`` set, its middleware's threads take every tick in that long
+    after it went out, for a microsecond of CPU, whether or not the program hears it."""
 
     clock: FakeClock
     idle_at: float = math.inf
@@ -55,6 +57,7 @@ class FakeProcess:
     hears_from: float = -math.inf
     delay: float = 0.0
     reaction: float = 0.0
+    middleware_delay: float | None = None
 
     def __call__(self, pid: int) -> ProcessState:
         now = self.clock.now
@@ -65,7 +68,12 @@ class FakeProcess:
             if got <= now:
                 cpu += min(now - got, self.reaction) + 1e-6
                 busy = busy or now < got + self.reaction
-        return ProcessState(busy=busy, cpu_ns=round(cpu * 1e9))
+        middleware = 0.0
+        if self.middleware_delay is not None:
+            middleware = 1e-6 * sum(1 for t in self.clock.ticks
+                                    if t + self.middleware_delay <= now)
+        return ProcessState(busy=busy, cpu_ns=round((cpu + middleware) * 1e9),
+                            own_busy=busy, own_cpu_ns=round(cpu * 1e9))
 
 
 @dataclass
@@ -440,6 +448,29 @@ def test_a_process_that_hears_no_ticks_costs_one_hear_timeout() -> None:
     assert run.pacer.late_deliveries == 0
     run.ticks_for(2)  # having heard the tick before, it is waited for again
     assert run.pacer.late_deliveries == 2
+
+
+def test_a_tick_only_the_middleware_took_in_is_not_heard() -> None:
+    """A node's middleware takes each ``/clock`` in on its own threads, whether or not
+    the node's executor wakes for it (seen at load 24: an executor woke only at its
+    ``spin_once`` timeout, 0.1 s later, while ticks went on as heard). A tick is heard
+    when the program's own threads run; an executor that never wakes is deaf, once."""
+    clock = FakeClock()
+    process = FakeProcess(clock, idle_at=clock.now, delay=0.1, reaction=0.01,
+                          middleware_delay=0.0)
+    run = Run(Pacer(DT, 1.0, clock=clock, read_process=process), clock)
+    run.pacer.watch(4242)
+    run.ticks_for(4)
+    assert run.pacer.counts == {"idle": 4} and run.pacer.late_deliveries == 4
+    assert run.pacer.longest_hold == pytest.approx(0.11, abs=0.002)  # woken, then done
+    assert run.gaps() == pytest.approx([0.11] * 3, abs=0.002)  # the next tick waited
+    asleep = FakeProcess(clock, idle_at=clock.now, hears_from=math.inf,
+                         middleware_delay=0.0)
+    run = Run(Pacer(DT, 1.0, clock=clock, read_process=asleep), clock)
+    run.pacer.watch(4242)
+    run.ticks_for(4)
+    assert run.pacer.counts == {"unheard": 1, "idle": 3}
+    assert run.gaps() == pytest.approx([0.5] + [0.05] * 2, abs=0.002)
 
 
 def test_a_tick_heard_after_the_timeout_still_counts_as_heard() -> None:

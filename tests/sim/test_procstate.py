@@ -297,6 +297,59 @@ def test_kept_files_follow_threads_that_come_and_go_and_close_with_the_process()
     assert _open_fds() == before
 
 
+# A thread named as Fast DDS names its receive threads spins; the main thread waits for
+# "go", then spins too.
+MIDDLEWARE_SPINS = [sys.executable, "-c", """
+import sys, threading
+named = threading.Event()
+def middleware():
+    with open(f"/proc/self/task/{threading.get_native_id()}/comm", "w") as fh:
+        fh.write("dds.udp.7411")
+    named.set()
+    while True:
+        pass
+threading.Thread(target=middleware, daemon=True).start()
+named.wait()
+print("spinning", flush=True)
+sys.stdin.readline()
+while True:
+    pass
+"""]
+
+
+def test_a_programs_own_threads_are_read_apart_from_its_middlewares() -> None:
+    """What Fast DDS's threads (``dds.*``) do counts in busy and CPU time, but not in the
+    program's own: a node's middleware taking a tick in is not its executor hearing it."""
+    proc = subprocess.Popen(MIDDLEWARE_SPINS, stdin=subprocess.PIPE,
+                            stdout=subprocess.PIPE, text=True)
+    assert proc.stdin is not None and proc.stdout is not None
+    try:
+        assert proc.stdout.readline() == "spinning\n"
+        readings = [read_process_state(proc.pid)]
+
+        def main_thread_waits() -> bool:  # it may still be on its way into readline
+            readings.append(read_process_state(proc.pid))
+            before, now = readings[-2:]
+            return not now.own_busy and now.own_cpu_ns == before.own_cpu_ns
+
+        assert _poll(main_thread_waits)
+        first = readings[-1]
+        assert _poll(lambda: read_process_state(proc.pid).cpu_ns > first.cpu_ns + 10**7)
+        middleware_only = read_process_state(proc.pid)
+        assert middleware_only.busy and not middleware_only.own_busy
+        assert middleware_only.own_cpu_ns == first.own_cpu_ns  # the main thread waits
+        proc.stdin.write("go\n")
+        proc.stdin.flush()
+        assert _poll(lambda: read_process_state(proc.pid).own_busy)
+        assert _poll(lambda: read_process_state(proc.pid).own_cpu_ns
+                     > middleware_only.own_cpu_ns + 10**7)
+    finally:
+        proc.kill()
+        proc.wait()
+        proc.stdin.close()
+        proc.stdout.close()
+
+
 def test_family_usage_keys_each_process_by_pid_and_start():
     spinner = _spinning()
     try:
