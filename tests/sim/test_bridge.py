@@ -262,6 +262,47 @@ def test_watched_process_paces_sim_time(graph: tuple[SimBridge, Probe]) -> None:
     assert not any(ended.get(k, 0) for k in ("budget", "unheard", "cap")), ended
 
 
+POSING_AS_MIDDLEWARE = """
+import os, rclpy
+from rclpy.node import Node
+rclpy.init()
+node = Node("posing", parameter_overrides=[
+    rclpy.parameter.Parameter("use_sim_time", value=True)])
+for tid in os.listdir("/proc/self/task"):  # every thread named as Fast DDS names its own
+    with open(f"/proc/self/task/{tid}/comm", "w") as fh:
+        fh.write("dds.posing")
+print("posing", flush=True)
+rclpy.spin(node)
+"""
+
+
+def test_a_node_posing_as_its_middleware_is_only_deaf(graph: tuple[SimBridge, Probe]) -> None:
+    """Heard is read from a program's own threads, not those named as Fast DDS names its
+    threads (``dds.*``). A program that names every thread so hears nothing the pacing
+    can see: it is waited for once, as a node without ``/clock`` is, then the world goes
+    on at its pace; it gains no hold."""
+    bridge, _ = graph
+    bridge.set_real_time_factor(1.0)
+    env = {**os.environ, "ROS_DOMAIN_ID": str(bridge.node.context.get_domain_id())}
+    posing = subprocess.Popen([sys.executable, "-c", POSING_AS_MIDDLEWARE], env=env,
+                              stdout=subprocess.PIPE, text=True)
+    try:
+        assert posing.stdout is not None and posing.stdout.readline() == "posing\n"
+        unheard = bridge.pacing.get("unheard", 0)
+        bridge.watch_pid(posing.pid)
+        assert bridge.wait_for(lambda: bridge.pacing.get("unheard", 0) > unheard, 5.0, WALL)
+        before = dict(bridge.pacing)
+        assert bridge.wait_until(bridge.now + 0.4, wall_timeout=WALL)
+        ended = {k: bridge.pacing.get(k, 0) - before.get(k, 0) for k in set(bridge.pacing)}
+    finally:
+        bridge.watch_pid(None)
+        posing.kill()
+        posing.wait()
+        posing.stdout.close()
+    assert ended.get("idle", 0) > 0, ended
+    assert not any(ended.get(k, 0) for k in ("budget", "unheard", "cap")), ended
+
+
 STUDENT = """
 import rclpy
 from geometry_msgs.msg import Twist
