@@ -77,6 +77,19 @@ class ProofModule(pytest.Module):
         return super().collect()
 
 
+SANDBOX = Path(__file__).parent / "sandbox"
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """The sandbox's slow tests are ``machine_wide``: they grade hostile programs and look
+    at the whole machine afterwards (every student user's processes, ``/tmp``, the network
+    beyond loopback), which another file's gradings at the same time would disturb, so the
+    slow tier runs them alone (``tasks.py test-all``)."""
+    for item in items:
+        if item.get_closest_marker("slow") and SANDBOX in item.path.parents:
+            item.add_marker(pytest.mark.machine_wide)
+
+
 def pytest_pycollect_makemodule(module_path: Path, parent: pytest.Collector) -> pytest.Module:
     return ProofModule.from_parent(parent, path=module_path)
 

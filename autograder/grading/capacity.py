@@ -32,8 +32,11 @@ from autograder.i18n import _, ngettext
 TARGET_LOAD = 2.0
 # Most gradings at once per core: the most shown to keep every score full (the same
 # section). Eight at once on 2 cores lost a correct error_handling node's test in 1 to 3
-# of 100 gradings (its world's clock went on while the node, starved of a CPU, had not yet
-# acted on it); four at once lost none of 100. Measured on 2 cores only.
+# of 100 gradings (the pacing took the node's middleware taking a tick in for the node
+# hearing it; fixed since, and twelve error_handling at once then kept 96 of 96); four at
+# once lost none of 100. Kept at two: a class of 100 at up to four a core was only 8 %
+# faster, slower for ai_bridge, and a world took a command seven ticks late
+# (benchmarks/RESULTS.md, 2026-11-28). Measured on 2 cores only.
 JOBS_PER_CORE = 2
 # Resident memory of one grading (pytest child, simulator, student node), with room for a
 # node that allocates more than a reference solution does.

@@ -22,14 +22,16 @@ def test_non_ros_dependencies_match_pyproject():
 
 def test_test_is_the_fast_tier_and_test_all_is_everything():
     """`tasks.py test` leaves out the gradings in the simulator (`slow`); `test-all` runs
-    the same, then the slow ones (together everything), and is what CI runs."""
+    the same, then the slow ones but the machine-wide ones in parallel, then those alone
+    (together everything), and is what CI runs."""
     (fast,) = tasks.JOBS["test"]
-    first, then = tasks.JOBS["test-all"]
+    first, slow, alone = tasks.JOBS["test-all"]
     assert fast == first
-    for command in (fast, then):
+    for command in (fast, slow, alone):
         assert command[:3] == ["python", "-m", "pytest"] and "-k" not in command
     assert fast[fast.index("-m", 3) + 1] == "not slow"
-    assert then[then.index("-m", 3) + 1] == "slow" and "-n" not in then
+    assert slow[slow.index("-m", 3) + 1] == "slow and not machine_wide" and "-n" in slow
+    assert alone[alone.index("-m", 3) + 1] == "machine_wide" and "-n" not in alone
     ci = (ROOT / ".ci" / "run").read_text()
     # The whole suite, then the benchmarks kept with the run (never a test's pass or fail).
     assert re.findall(r"^python3 tasks\.py (\S+)", ci, re.M) == ["test-all", "bench-ci"]
