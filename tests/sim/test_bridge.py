@@ -226,6 +226,17 @@ def _rtf_over(bridge: SimBridge, sim_seconds: float) -> float:
     return bridge.effective_rtf
 
 
+def _holds_after_it_is_found_deaf(bridge: SimBridge, pid: int) -> dict[str, int]:
+    """Watch ``pid``, which hears no ticks: the first tick is held ``hear_timeout`` for it
+    (wait for that); then how the holds of the next 0.4 s of sim time ended."""
+    unheard = bridge.pacing.get("unheard", 0)
+    bridge.watch_pid(pid)
+    assert bridge.wait_for(lambda: bridge.pacing.get("unheard", 0) > unheard, 5.0, WALL)
+    before = dict(bridge.pacing)
+    assert bridge.wait_until(bridge.now + 0.4, wall_timeout=WALL)
+    return {k: bridge.pacing.get(k, 0) - before.get(k, 0) for k in set(bridge.pacing)}
+
+
 def test_watched_process_paces_sim_time(graph: tuple[SimBridge, Probe]) -> None:
     """A busy student process holds sim time back; an idle one that hears no ticks does
     not, once it has been waited for to hear one."""
@@ -239,13 +250,7 @@ def test_watched_process_paces_sim_time(graph: tuple[SimBridge, Probe]) -> None:
         slowed = _rtf_over(bridge, 0.4)
         let_go = bridge.pacing["budget"] - before.get("budget", 0)
         bridge.unwatch_pid(busy.pid)
-        bridge.watch_pid(idle.pid)
-        # It hears no ticks (it has no node): the first is held hear_timeout for it.
-        unheard = bridge.pacing.get("unheard", 0)
-        assert bridge.wait_for(lambda: bridge.pacing.get("unheard", 0) > unheard, 5.0, WALL)
-        before = dict(bridge.pacing)
-        assert bridge.wait_until(bridge.now + 0.4, wall_timeout=WALL)
-        ended = {k: bridge.pacing.get(k, 0) - before.get(k, 0) for k in set(bridge.pacing)}
+        ended = _holds_after_it_is_found_deaf(bridge, idle.pid)  # it has no node
     finally:
         bridge.watch_pid(None)
         for proc in (busy, idle):
@@ -288,12 +293,7 @@ def test_a_node_posing_as_its_middleware_is_only_deaf(graph: tuple[SimBridge, Pr
                               stdout=subprocess.PIPE, text=True)
     try:
         assert posing.stdout is not None and posing.stdout.readline() == "posing\n"
-        unheard = bridge.pacing.get("unheard", 0)
-        bridge.watch_pid(posing.pid)
-        assert bridge.wait_for(lambda: bridge.pacing.get("unheard", 0) > unheard, 5.0, WALL)
-        before = dict(bridge.pacing)
-        assert bridge.wait_until(bridge.now + 0.4, wall_timeout=WALL)
-        ended = {k: bridge.pacing.get(k, 0) - before.get(k, 0) for k in set(bridge.pacing)}
+        ended = _holds_after_it_is_found_deaf(bridge, posing.pid)
     finally:
         bridge.watch_pid(None)
         posing.kill()
