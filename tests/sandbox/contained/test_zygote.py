@@ -3,7 +3,8 @@
 Each case runs the same program both ways (``AUTOGRADER_ZYGOTE=0`` execs it through the
 launcher) and compares what a grader sees: exit status, output, and the program's view
 of itself (argv, working folder, environment, module path, ``__name__``, the thread
-switch interval of :mod:`autograder.sandbox.contained.runner`).
+switch interval of :mod:`autograder.sandbox.contained.runner` and its executors' wait on a
+subscription's QoS events).
 """
 
 from __future__ import annotations
@@ -45,8 +46,16 @@ PROGRAMS = {
     # A node left undestroyed at exit: a fork without LTTng's hooks died of SIGSEGV here.
     "exit_code": SELF + """\
 import rclpy
+from std_msgs.msg import Empty
 rclpy.init()
 node = rclpy.create_node("zygote_test")
+subscription = node.create_subscription(Empty, "zygote_test", lambda message: None, 1)
+every = len(list(node.waitables))
+subscription._executor_event = True  # as an executor marks it, its message handed out
+held = every - len(list(node.waitables))
+print("held back", held == len(subscription.event_handlers) > 0)
+subscription._executor_event = False
+print("waited on again", len(list(node.waitables)) == every)
 rclpy.shutdown()
 sys.exit(3)
 """,
@@ -97,7 +106,9 @@ def test_a_forked_program_ends_as_an_execd_one(name: str, tmp_path: Path,
     assert forked_output == execd_output
     assert ("argv ['prog.py', '--ros-args']\ncwd True\npath0 True __main__\nenv 7 True\n"
             "switch 0.0005\n") in forked_output  # the GIL handed over within 0.5 ms (runner)
-    if name != "exit_code":  # the traceback names the student's frames only
+    if name == "exit_code":  # a subscription's QoS events wait with its message (runner)
+        assert "held back True\nwaited on again True\n" in forked_output
+    else:  # the traceback names the student's frames only
         assert "prog.py" in forked_output
         for ours in ("zygote", "runner", "<string>"):
             assert ours not in forked_output and ours not in execd_output
