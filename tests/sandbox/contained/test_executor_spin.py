@@ -78,9 +78,9 @@ def test_a_multithreaded_executor_goes_round_a_few_times_a_clock_message(
     with output.open("w") as out:
         program = subprocess.Popen(command(sys.executable, str(script), []), stdout=out,
                                    stderr=subprocess.STDOUT, env=env)
-    os.environ["ROS_DOMAIN_ID"] = str(ros_domain)
-    rclpy.init()
-    world = Node("spin_test_world")
+    context = rclpy.Context()
+    rclpy.init(context=context, domain_id=ros_domain)
+    world = Node("spin_test_world", context=context)
     try:
         clock = world.create_publisher(Clock, "/clock", 10)
         deadline = time.monotonic() + WALL
@@ -102,7 +102,7 @@ def test_a_multithreaded_executor_goes_round_a_few_times_a_clock_message(
             program.kill()
         program.wait()
         world.destroy_node()
-        rclpy.shutdown()
+        rclpy.shutdown(context=context)
     report = output.read_text()
     words = report.split()
     assert "rounds" in words, report
