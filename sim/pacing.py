@@ -28,6 +28,11 @@ design notes, "Pacing"):
   Then the world's own middleware must have taken in what the processes sent, up to
   ``receive_timeout``.  ``hold_cap`` ends a hold, not counting the time in which every busy
   watched process waited for a CPU; ``hold_limit`` ends it whatever the machine.
+* **Blocked.**  A process with a thread asleep in the kernel uninterruptibly (state
+  ``D``: a page read in from disk, memory reclaimed) is not done: it goes on by itself.
+  The hold waits for it as long as its ``blocked_reserve`` lasts, wall time taken from a
+  store that starts full and is never paid back, so a process that stays blocked costs
+  that much once, not every tick.
 * **CPU reserve.**  Each watched process banks, up to ``cpu_reserve``, the part of
   ``cpu_budget`` it leaves unused in each tick, and a hold draws on that bank once the
   budget is used: a usually idle node may take a longer turn now and then (an executor
@@ -126,12 +131,16 @@ class PacingPolicy:
     receive_timeout: float = 0.5
     """Longest wait, once the watched processes are done, for the world's middleware to
     take in what they sent."""
+    blocked_reserve: float = 1.0
+    """Most wall seconds, over a watched process's whole life, that holds wait for it
+    while a thread of it sleeps in the kernel uninterruptibly (state ``D``) and it is
+    otherwise done."""
 
     def __post_init__(self) -> None:
         if self.clock_hz <= 0:
             raise ValueError("clock_hz must be > 0")
-        if self.cpu_budget < 0 or self.cpu_reserve < 0:
-            raise ValueError("cpu_budget and cpu_reserve must be >= 0")
+        if self.cpu_budget < 0 or self.cpu_reserve < 0 or self.blocked_reserve < 0:
+            raise ValueError("cpu_budget, cpu_reserve and blocked_reserve must be >= 0")
 
 
 @dataclass(frozen=True)
@@ -192,6 +201,7 @@ class Pacer:
         # Holds that, the processes done, waited for the world to take in what they sent.
         self.receipts_awaited = 0
         self._reserve: dict[int, float] = {}  # CPU seconds each watched process has banked
+        self._blocked_left: dict[int, float] = {}  # wall s each may yet be waited for in D
         # Each watched process as read just before a tick went out.
         self._before: dict[int, ProcessState] = {}
         self._heard: set[int] = set()  # those seen to hear the last tick during its hold
@@ -264,11 +274,13 @@ class Pacer:
                 self._listening.clear()
                 self._closing.clear()
                 self._reserve.clear()
+                self._blocked_left.clear()
             else:
                 self._pids.add(pid)
                 self._listening.add(pid)
                 self._closing.discard(pid)
                 self._reserve.setdefault(pid, 0.0)
+                self._blocked_left.setdefault(pid, self.policy.blocked_reserve)
             self._window.clear()
 
     @property
@@ -283,6 +295,7 @@ class Pacer:
             self._listening.discard(pid)
             self._closing.discard(pid)
             self._reserve.pop(pid, None)
+            self._blocked_left.pop(pid, None)
 
     def closing(self, pid: int) -> None:
         """Process ``pid`` is being stopped: hold ticks while it has work, as before, but
@@ -302,7 +315,7 @@ class Pacer:
                 continue
             if pid in self._closing:
                 continue
-            if (pid in self._heard or not state.exists or state.own_busy
+            if (pid in self._heard or not state.exists or state.own_busy or state.own_blocked
                     or state.own_cpu_ns > self._before[pid].own_cpu_ns):
                 self._listening.add(pid)
             else:
@@ -399,6 +412,7 @@ class Pacer:
             pids = tuple(self._pids)
             before, listening = dict(self._before), frozenset(self._listening)
             reserve = {pid: self._reserve.get(pid, 0.0) for pid in pids}
+            blocked_left = {pid: self._blocked_left.get(pid, 0.0) for pid in pids}
         if not pids:
             return None
         policy = self.policy
@@ -416,7 +430,7 @@ class Pacer:
                      reserve=reserve,
                      share_ns={pid: budget_ns + int(reserve[pid] * 1e9) for pid in pids},
                      heard={pid: pid not in before for pid in pids}, listening=listening,
-                     cap=published + policy.hold_cap)
+                     cap=published + policy.hold_cap, blocked_left=blocked_left)
 
     def _poll(self, hold: _Hold) -> HoldOutcome:
         """Read the watched processes until the hold may end; how it ended."""
@@ -426,7 +440,7 @@ class Pacer:
         receipt_due: float | None = None  # set once the processes are done
         pause, then = policy.poll_interval, clock.monotonic()
         while (now := clock.monotonic()) < min(hold.cap, limit):
-            if hold.read({pid: self._read(pid) for pid in hold.baseline}):
+            if hold.read({pid: self._read(pid) for pid in hold.baseline}, now - then):
                 hold.cap += now - then  # they all waited for a CPU since the last look
                 pause = min(2 * pause, policy.starved_poll_max)
             else:
@@ -463,6 +477,9 @@ class Pacer:
                 if pid in self._reserve:  # not unwatched meanwhile
                     self._reserve[pid] = min(self.policy.cpu_reserve, max(
                         0.0, hold.reserve[pid] + (budget_ns - used_ns) / 1e9))
+            for pid, left in hold.blocked_left.items():
+                if pid in self._blocked_left:
+                    self._blocked_left[pid] = left
         self.bursts += burst
         self.receipts_awaited += hold.awaited
         self.counts[outcome] += 1
@@ -486,25 +503,38 @@ class _Hold:
     heard: dict[int, bool]  # whether each has heard the tick
     listening: frozenset[int]  # those that heard the tick before: waited for to hear it
     cap: float  # when hold_cap ends the hold (pushed back while they wait for a CPU)
+    blocked_left: dict[int, float] = field(default_factory=dict)  # wall s each may be
+    # waited for while blocked in the kernel (state D)
     states: dict[int, ProcessState] = field(default_factory=dict)  # the last reading
     late: bool = False  # an idle process had not heard the tick yet
     awaited: bool = False  # the world's middleware was still taking messages in
     still: bool = False  # the last two readings agree that none of them works
 
-    def read(self, states: dict[int, ProcessState]) -> bool:
-        """Take a reading; True if every busy process waited for a CPU since the last."""
+    def read(self, states: dict[int, ProcessState], since: float = 0.0) -> bool:
+        """Take a reading, ``since`` wall seconds after the last; True if every busy
+        process waited for a CPU since the last."""
         previous, self.states = self.states, states
         for pid, state in states.items():
             self.heard[pid] = self.heard[pid] or (
-                not state.exists or state.own_busy
+                not state.exists or state.own_busy or state.own_blocked
                 or state.own_cpu_ns > self.own_baseline[pid])
+            was = previous.get(pid)
+            if was is not None and was.blocked and not was.busy and self._waited_for(pid):
+                # waited for only because it was blocked: that comes from its store
+                self.blocked_left[pid] = max(0.0, self.blocked_left[pid] - since)
         # A reading of a process is one thread after another, not one instant: a thread
         # woken by another after we read it, the other gone to sleep before we read it,
         # reads idle.  It will have run, or be runnable, by the next reading.
         self.still = all(not state.exists or self._spent(pid) or (
             pid in previous and not previous[pid].busy and not state.busy
+            and not ((state.blocked or previous[pid].blocked) and self._waited_for(pid))
             and previous[pid].cpu_ns == state.cpu_ns) for pid, state in states.items())
         return _starved(previous, states)
+
+    def _waited_for(self, pid: int) -> bool:
+        """Process ``pid``, if blocked in the kernel, is still waited for: its store of
+        such waits is not used up."""
+        return self.blocked_left.get(pid, 0.0) > 0.0
 
     def _spent(self, pid: int) -> bool:
         """Process ``pid`` has used its share since the tick (it is let go, busy or not)."""

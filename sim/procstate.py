@@ -5,6 +5,9 @@ Two facts per process, summed over its threads:
 * **busy**: some thread is running or runnable (state ``R`` in
   ``/proc/<pid>/task/*/stat``).  A runnable thread that waits for a CPU counts as busy,
   which is what lets a starved process hold simulation time back.
+* **blocked**: some thread sleeps in the kernel uninterruptibly (state ``D``): a page
+  being read in from disk, memory being reclaimed, a ``vfork`` child not yet started.
+  It waits for the machine, not for a message, and goes on by itself.
 * **cpu_ns**: CPU time used so far, in nanoseconds (the first field of
   ``/proc/<pid>/task/*/schedstat``).  Told apart from *busy*, it separates a process that
   computes (its CPU time grows) from one that only waits for a CPU (it does not).
@@ -42,12 +45,16 @@ class ProcessState:
     exists: bool = True
     own_busy: bool = None  # type: ignore[assignment]  # None: as busy
     own_cpu_ns: int = None  # type: ignore[assignment]  # None: as cpu_ns
+    blocked: bool = False  # some thread is in uninterruptible sleep (state D)
+    own_blocked: bool = None  # type: ignore[assignment]  # None: as blocked
 
     def __post_init__(self) -> None:
         if self.own_busy is None:
             object.__setattr__(self, "own_busy", self.busy)
         if self.own_cpu_ns is None:
             object.__setattr__(self, "own_cpu_ns", self.cpu_ns)
+        if self.own_blocked is None:
+            object.__setattr__(self, "own_blocked", self.blocked)
 
 
 IDLE = ProcessState(busy=False, cpu_ns=0, exists=False)
@@ -63,11 +70,15 @@ MIDDLEWARE_THREADS = b"dds."
 middleware's, not the program's."""
 
 
-def _thread_running(stat: bytes) -> bool:
+def _thread_state(stat: bytes) -> bytes:
     # The state follows the command name, which is in parentheses and may itself hold
     # spaces or parentheses: read it after the last ")".
     end = stat.rindex(b")")
-    return stat[end + 2:end + 3] == b"R"
+    return stat[end + 2:end + 3]
+
+
+def _thread_running(stat: bytes) -> bool:
+    return _thread_state(stat) == b"R"
 
 
 def _middleware_thread(stat: bytes) -> bool:
@@ -107,7 +118,7 @@ def read_process_state(pid: int) -> ProcessState:
         with _open_lock:
             _close_process(pid)
         return IDLE
-    busy, cpu, own_busy, own_cpu = False, 0, False, 0
+    busy, cpu, own_busy, own_cpu, blocked, own_blocked = False, 0, False, 0, False, False
     with _open_lock:
         files = _open.pop(pid, None) or {}
         _open[pid] = files  # last: the most recently read
@@ -118,26 +129,28 @@ def read_process_state(pid: int) -> ProcessState:
         for tid in tids:
             reading = _read_thread(base, tid, files)
             if reading is not None:
-                running, used, middleware = reading
-                busy = busy or running
+                state, used, middleware = reading
+                running, waiting = state == b"R", state == b"D"
+                busy, blocked = busy or running, blocked or waiting
                 cpu += used
                 if not middleware:
-                    own_busy = own_busy or running
+                    own_busy, own_blocked = own_busy or running, own_blocked or waiting
                     own_cpu += used
-    return ProcessState(busy, cpu, own_busy=own_busy, own_cpu_ns=own_cpu)
+    return ProcessState(busy, cpu, own_busy=own_busy, own_cpu_ns=own_cpu, blocked=blocked,
+                        own_blocked=own_blocked)
 
 
 def _read_thread(base: str, tid: str, files: dict[str, tuple[int, int]],
-                 ) -> tuple[bool, int, bool] | None:
-    """(running or runnable, CPU ns, the middleware's) of one thread through its kept
-    files; None if it cannot be read (it ended between listing and reading)."""
+                 ) -> tuple[bytes, int, bool] | None:
+    """(state letter, CPU ns, the middleware's) of one thread through its kept files;
+    None if it cannot be read (it ended between listing and reading)."""
     for attempt in range(2):
         fds = files.get(tid)
         try:
             if fds is None:
                 fds = files[tid] = _open_thread(f"{base}{tid}/")
             stat = os.pread(fds[0], 4096, 0)
-            return (_thread_running(stat), int(os.pread(fds[1], 128, 0).split()[0]),
+            return (_thread_state(stat), int(os.pread(fds[1], 128, 0).split()[0]),
                     _middleware_thread(stat))
         except (OSError, ValueError, IndexError):
             if tid in files:

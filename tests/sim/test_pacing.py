@@ -49,7 +49,9 @@ class FakeProcess:
     that went out from ``hears_from`` on: each reaches it ``delay`` after it went out, and
     it then computes for ``reaction`` (at least a microsecond: a message costs some CPU).
     With ``middleware_delay`` set, its middleware's threads take every tick in that long
-    after it went out, for a microsecond of CPU, whether or not the program hears it."""
+    after it went out, for a microsecond of CPU, whether or not the program hears it.
+    Until ``blocked_until`` one of its own threads sleeps in the kernel uninterruptibly
+    (state D: a page being read in), using no CPU."""
 
     clock: FakeClock
     idle_at: float = math.inf
@@ -58,6 +60,7 @@ class FakeProcess:
     delay: float = 0.0
     reaction: float = 0.0
     middleware_delay: float | None = None
+    blocked_until: float = -math.inf
 
     def __call__(self, pid: int) -> ProcessState:
         now = self.clock.now
@@ -72,8 +75,9 @@ class FakeProcess:
         if self.middleware_delay is not None:
             middleware = 1e-6 * sum(1 for t in self.clock.ticks
                                     if t + self.middleware_delay <= now)
+        blocked = now < self.blocked_until
         return ProcessState(busy=busy, cpu_ns=round((cpu + middleware) * 1e9),
-                            own_busy=busy, own_cpu_ns=round(cpu * 1e9))
+                            own_busy=busy, own_cpu_ns=round(cpu * 1e9), blocked=blocked)
 
 
 @dataclass
@@ -404,6 +408,41 @@ def test_every_watched_process_must_be_done() -> None:
     run.pacer.watch(None)
     run.tick()
     assert run.pacer.counts == {"budget": 1, "idle": 1, "free": 1}
+
+
+def test_a_process_blocked_in_the_kernel_is_waited_for() -> None:
+    """A node that reacts to a tick and then waits for a page from disk (state D) is not
+    done: read idle, the world went on for four ticks while a correct node's first warning
+    loaded, and its stop came late (benchmarks/RESULTS.md)."""
+    clock = FakeClock()
+    process = FakeProcess(clock, idle_at=clock.now, reaction=0.002,
+                          blocked_until=clock.now + 0.3)
+    run = Run(Pacer(DT, 1.0, clock=clock, read_process=process), clock)
+    run.pacer.watch(4242)
+    run.tick()
+    assert run.pacer.counts == {"idle": 1}
+    assert run.pacer.longest_hold == pytest.approx(0.3, abs=0.002)
+    run.ticks_for(3)  # no longer blocked: as any idle process
+    assert run.pacer.counts == {"idle": 4}
+    assert run.gaps()[1:] == pytest.approx([0.05] * 2, abs=1e-9)
+
+
+def test_a_process_that_stays_blocked_costs_its_blocked_reserve_once() -> None:
+    """A thread that never leaves state D (a vfork child that never starts) holds sim
+    time for ``blocked_reserve`` of wall time in all, then reads as done."""
+    clock = FakeClock()
+    process = FakeProcess(clock, idle_at=clock.now, reaction=0.002, blocked_until=math.inf)
+    run = Run(Pacer(DT, 1.0, PacingPolicy(blocked_reserve=0.4), clock=clock,
+                    read_process=process), clock)
+    run.pacer.watch(4242)
+    run.ticks_for(5)
+    assert run.pacer.counts == {"idle": 5}
+    assert run.pacer.longest_hold == pytest.approx(0.4, abs=0.005)
+    assert run.gaps()[1:] == pytest.approx([0.05] * 3, abs=1e-9)  # then, as if done
+    run.pacer.watch(4243)  # a new process (its next start) has a full store
+    before = clock.now
+    run.tick()
+    assert clock.now - before == pytest.approx(0.4, abs=0.005)
 
 
 def test_a_gone_process_reads_idle() -> None:
