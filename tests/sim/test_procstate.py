@@ -61,6 +61,30 @@ def test_process_busy_reads_proc() -> None:
     assert read_process_state(2**22 + 12345) == IDLE
 
 
+def test_a_thread_asleep_in_the_kernel_reads_blocked_not_busy(tmp_path) -> None:
+    """State D (uninterruptible sleep: a page read in from disk, memory reclaimed) is
+    neither idle nor busy: the pacing waits for it from a store of its own. A process
+    whose ``posix_spawn`` child (glibc: clone with CLONE_VFORK) is stuck opening a FIFO no
+    one writes waits in D until the child goes on."""
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    helper = subprocess.Popen([sys.executable, "-c", (
+        "import os\n"
+        f"os.posix_spawn('/bin/true', ['true'], {{}}, file_actions=[(os.POSIX_SPAWN_OPEN, 3, "
+        f"{str(fifo)!r}, os.O_RDONLY, 0)])\n")])
+    try:
+        assert _poll(lambda: read_process_state(helper.pid).blocked)
+        state = read_process_state(helper.pid)
+        assert state.blocked and state.own_blocked and not state.busy
+    finally:
+        try:  # the child's open returns: it execs, and its parent goes on
+            os.close(os.open(fifo, os.O_WRONLY | os.O_NONBLOCK))
+        except OSError:  # no one opened it: the helper never got that far
+            helper.kill()
+        helper.wait(timeout=WALL)
+    assert helper.returncode == 0
+
+
 def test_a_computing_process_is_busy_and_uses_cpu(spinner: subprocess.Popen[str]) -> None:
     start = read_process_state(spinner.pid)
     assert start.busy and start.cpu_ns > 0
@@ -299,15 +323,18 @@ def test_kept_files_follow_threads_that_come_and_go_and_close_with_the_process()
 
 # A thread named as Fast DDS names its receive threads spins; the main thread waits for
 # "go", then spins too.
+# The middleware's thread spins in C without the GIL (pbkdf2_hmac releases it), as Fast
+# DDS's do: a Python loop would hold the GIL, and the main thread, waiting for it on its
+# way into readline, would read idle once and then use CPU.
 MIDDLEWARE_SPINS = [sys.executable, "-c", """
-import sys, threading
+import hashlib, sys, threading
 named = threading.Event()
 def middleware():
     with open(f"/proc/self/task/{threading.get_native_id()}/comm", "w") as fh:
         fh.write("dds.udp.7411")
     named.set()
     while True:
-        pass
+        hashlib.pbkdf2_hmac("sha256", b"x", b"y", 10**6)
 threading.Thread(target=middleware, daemon=True).start()
 named.wait()
 print("spinning", flush=True)
