@@ -200,6 +200,8 @@ class Pacer:
         self.bursts = 0
         # Holds that, the processes done, waited for the world to take in what they sent.
         self.receipts_awaited = 0
+        # Holds that waited for a process blocked in the kernel (state D), from its store.
+        self.blocked_waits = 0
         self._reserve: dict[int, float] = {}  # CPU seconds each watched process has banked
         self._blocked_left: dict[int, float] = {}  # wall s each may yet be waited for in D
         # Each watched process as read just before a tick went out.
@@ -482,6 +484,7 @@ class Pacer:
                     self._blocked_left[pid] = left
         self.bursts += burst
         self.receipts_awaited += hold.awaited
+        self.blocked_waits += hold.blocked_wait
         self.counts[outcome] += 1
         if hold.late and outcome != "unheard":
             self.late_deliveries += 1
@@ -508,6 +511,7 @@ class _Hold:
     states: dict[int, ProcessState] = field(default_factory=dict)  # the last reading
     late: bool = False  # an idle process had not heard the tick yet
     awaited: bool = False  # the world's middleware was still taking messages in
+    blocked_wait: bool = False  # a process was waited for while blocked in the kernel
     still: bool = False  # the last two readings agree that none of them works
 
     def read(self, states: dict[int, ProcessState], since: float = 0.0) -> bool:
@@ -522,6 +526,7 @@ class _Hold:
             if was is not None and was.blocked and not was.busy and self._waited_for(pid):
                 # waited for only because it was blocked: that comes from its store
                 self.blocked_left[pid] = max(0.0, self.blocked_left[pid] - since)
+                self.blocked_wait = True
         # A reading of a process is one thread after another, not one instant: a thread
         # woken by another after we read it, the other gone to sleep before we read it,
         # reads idle.  It will have run, or be runnable, by the next reading.

@@ -257,7 +257,8 @@ class ModulePacing:
     each way (``outcomes``, by :data:`sim.pacing.HoldOutcome`: ``free``, ``idle``,
     ``budget``, ``cap``, ...; only those that happened, in the order they first did), the
     longest hold and all held, in wall seconds, and the bridge's counters (late deliveries
-    and commands, bursts, receipts awaited, the latest command's lateness in sim seconds).
+    and commands, bursts, receipts awaited, waits for a process blocked in the kernel, the
+    latest command's lateness in sim seconds).
     A counter is None where the results did not carry it (an older file)."""
 
     outcomes: Mapping[str, int] = dataclasses.field(default_factory=dict)
@@ -266,6 +267,7 @@ class ModulePacing:
     late_deliveries: int | None = None
     bursts: int | None = None
     receipts_awaited: int | None = None
+    blocked_waits: int | None = None
     late_commands: int | None = None
     latest_command: float | None = None
 

@@ -118,6 +118,7 @@ def world(request: pytest.FixtureRequest, exercise: Exercise,
                 "late_deliveries": bridge.pacer.late_deliveries,
                 "bursts": bridge.pacer.bursts,
                 "receipts_awaited": bridge.pacer.receipts_awaited,
+                "blocked_waits": bridge.pacer.blocked_waits,
                 "late_commands": bridge.late_commands,
                 "latest_command": round(bridge.latest_command, 3)}
 

@@ -221,8 +221,8 @@ def test_not_run_says_what_the_grade_adds() -> None:
 
 def test_a_modules_pacing_keeps_its_outcomes_apart_from_its_counters_and_their_order() -> None:
     written = {"free": 20, "budget": 1, "idle": 50, "longest_hold": 0.14, "held_seconds": 0.222,
-               "late_deliveries": 1, "bursts": 0, "receipts_awaited": 0, "late_commands": 0,
-               "latest_command": 0.0}
+               "late_deliveries": 1, "bursts": 0, "receipts_awaited": 0, "blocked_waits": 2,
+               "late_commands": 0, "latest_command": 0.0}
     pacing = ModulePacing.from_dict(written)
     assert dict(pacing.outcomes) == {"free": 20, "budget": 1, "idle": 50}
     assert pacing.count("budget") == 1 and pacing.count("cap") == 0

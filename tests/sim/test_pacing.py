@@ -423,7 +423,7 @@ def test_a_process_blocked_in_the_kernel_is_waited_for() -> None:
     assert run.pacer.counts == {"idle": 1}
     assert run.pacer.longest_hold == pytest.approx(0.3, abs=0.002)
     run.ticks_for(3)  # no longer blocked: as any idle process
-    assert run.pacer.counts == {"idle": 4}
+    assert run.pacer.counts == {"idle": 4} and run.pacer.blocked_waits == 1
     assert run.gaps()[1:] == pytest.approx([0.05] * 2, abs=1e-9)
 
 
@@ -436,7 +436,7 @@ def test_a_process_that_stays_blocked_costs_its_blocked_reserve_once() -> None:
                     read_process=process), clock)
     run.pacer.watch(4242)
     run.ticks_for(5)
-    assert run.pacer.counts == {"idle": 5}
+    assert run.pacer.counts == {"idle": 5} and run.pacer.blocked_waits == 1
     assert run.pacer.longest_hold == pytest.approx(0.4, abs=0.005)
     assert run.gaps()[1:] == pytest.approx([0.05] * 3, abs=1e-9)  # then, as if done
     run.pacer.watch(4243)  # a new process (its next start) has a full store
