@@ -179,6 +179,17 @@ def test_the_message_says_what_happened(graded, name, expected):
     assert expected in messages(graded[name][0])
 
 
+def test_a_thread_left_in_the_kernel_holds_sim_time_once(graded):
+    """A node with a thread in uninterruptible sleep (state D) for good is waited for from
+    its store (``blocked_reserve``) once, not every tick: each module's holds drew on it,
+    none ran to ``hold_cap``, and the node, which works, keeps its score."""
+    result = graded["blocks_in_the_kernel"][0]
+    assert result.score == 3, messages(result)
+    assert result.pacing
+    for module, pacing in result.pacing.items():
+        assert pacing.blocked_waits and pacing.count("cap") == 0, (module, pacing)
+
+
 @pytest.mark.parametrize("name", ["publishes_world_topics", "probe_name"])
 def test_tampering_is_caught_not_rewarded(graded, name):
     result = graded[name][0]
