@@ -317,7 +317,8 @@ class Pacer:
                 continue
             if pid in self._closing:
                 continue
-            if (pid in self._heard or not state.exists or state.own_busy or state.own_blocked
+            blocked = state.own_blocked and self._blocked_left.get(pid, 0.0) > 0.0
+            if (pid in self._heard or not state.exists or state.own_busy or blocked
                     or state.own_cpu_ns > self._before[pid].own_cpu_ns):
                 self._listening.add(pid)
             else:
@@ -506,8 +507,8 @@ class _Hold:
     heard: dict[int, bool]  # whether each has heard the tick
     listening: frozenset[int]  # those that heard the tick before: waited for to hear it
     cap: float  # when hold_cap ends the hold (pushed back while they wait for a CPU)
-    blocked_left: dict[int, float] = field(default_factory=dict)  # wall s each may be
-    # waited for while blocked in the kernel (state D)
+    # Wall seconds each may still be waited for while blocked in the kernel (state D).
+    blocked_left: dict[int, float] = field(default_factory=dict)
     states: dict[int, ProcessState] = field(default_factory=dict)  # the last reading
     late: bool = False  # an idle process had not heard the tick yet
     awaited: bool = False  # the world's middleware was still taking messages in
@@ -520,7 +521,8 @@ class _Hold:
         previous, self.states = self.states, states
         for pid, state in states.items():
             self.heard[pid] = self.heard[pid] or (
-                not state.exists or state.own_busy or state.own_blocked
+                not state.exists or state.own_busy
+                or (state.own_blocked and self._waited_for(pid))
                 or state.own_cpu_ns > self.own_baseline[pid])
             was = previous.get(pid)
             if was is not None and was.blocked and not was.busy and self._waited_for(pid):
