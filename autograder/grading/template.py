@@ -58,6 +58,10 @@ WARM_MODULES = (
     "autograder.core.submission", "autograder.sandbox.process", "sim.bridge",
 )
 FORGOTTEN = "autograder.plugin"
+# Each signal as this interpreter started with it, before any handler of ours: what a
+# fresh interpreter the grader starts has, a signal the grader ignores included (SIGINT,
+# when a script started it in the background), since an exec keeps ignored signals.
+AT_START = {signum: signal.getsignal(signum) for signum in signal.valid_signals()}
 SETUP_FAILED = 121  # a forked child's exit status when it could not become the child
 CLONE_NEWNS, CLONE_NEWNET = 0x00020000, 0x40000000
 MS_REC, MS_PRIVATE = 0x4000, 1 << 18
@@ -160,13 +164,15 @@ def _in_child(sock: socket.socket, request: Mapping[str, Any], fds: Sequence[int
 
 
 def _default_signals() -> None:
-    """Every signal as a fresh interpreter has it, whatever the template inherited: SIGINT
-    raises KeyboardInterrupt, SIGPIPE and SIGXFSZ are ignored, the rest default."""
-    python = {signal.SIGINT: signal.default_int_handler, signal.SIGPIPE: signal.SIG_IGN,
-              signal.SIGXFSZ: signal.SIG_IGN}
+    """Every signal as a fresh interpreter started by the grader has it, whatever the
+    template set since (``AT_START``): SIGINT raises KeyboardInterrupt, SIGPIPE and SIGXFSZ
+    are ignored, the rest default, and one the grader ignores stays ignored."""
     for signum in signal.valid_signals() - {signal.SIGKILL, signal.SIGSTOP}:
-        with contextlib.suppress(OSError, ValueError):  # those the C library keeps
-            signal.signal(signum, python.get(signum, signal.SIG_DFL))
+        handler = AT_START.get(signum)
+        if handler is None:  # set outside Python: as a fresh interpreter, the default
+            handler = signal.SIG_DFL
+        with contextlib.suppress(OSError, ValueError, TypeError):  # those the C library keeps
+            signal.signal(signum, handler)
 
 
 def _own_namespaces(libc: ctypes.CDLL) -> None:

@@ -81,6 +81,26 @@ def spawn(warm: Template, folder: Path, source: str, passed: Sequence[int] = (),
                           passed, namespaces=namespaces)
 
 
+def test_a_signal_the_grader_ignores_stays_ignored_in_a_forked_child(tmp_path: Path) -> None:
+    """A grader a script started in the background ignores SIGINT, and an exec keeps an
+    ignored signal: so does a child forked from a template that grader started (the CI
+    run that found it: a forked child raised KeyboardInterrupt where an exec'd one could
+    not)."""
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        template = Template(child_env())
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    try:
+        out = tmp_path / "seen.json"
+        assert spawn(template, tmp_path, SELF, MARK="m", OUT=str(out)).wait(WALL) == 0
+        signals = json.loads(out.read_text())["signals"]
+        assert signals["SIGINT"] == str(signal.SIG_IGN), signals
+        assert signals["SIGTERM"] == str(signal.SIG_DFL), signals
+    finally:
+        template.close()
+
+
 def test_a_forked_child_sees_itself_as_an_execd_one(warm: Template, tmp_path: Path) -> None:
     """The same test module forked and exec'd: the same descriptors (the passed ones at
     the numbers asked, on the same pipes, nothing of the template's), arguments, folder,
