@@ -171,7 +171,7 @@ def _default_signals() -> None:
         handler = AT_START.get(signum)
         if handler is None:  # set outside Python: as a fresh interpreter, the default
             handler = signal.SIG_DFL
-        with contextlib.suppress(OSError, ValueError, TypeError):  # those the C library keeps
+        with contextlib.suppress(OSError, ValueError):  # those the C library keeps
             signal.signal(signum, handler)
 
 
