@@ -22,9 +22,9 @@ PLAN_PERIOD = 10.0
 PLAN_SECONDS = 2.0
 # How far a plan may be from its expected time: a tick or two either side (sim seconds).
 PLAN_TOLERANCE = 0.25
-# The run: sim seconds at the exercise's pace (RTF 4, /clock at 80 Hz: ticks of 0.05 s of
+# The run: sim seconds at the exercise's pace (RTF 5, /clock at 100 Hz: ticks of 0.05 s of
 # sim time, as at RTF 1 and 20 Hz), then at OTHER_RTF.  A node timed by the wall clock
-# shows a quarter of its rates in sim time at RTF 4 and twice them at half pace.  Jazzy's
+# shows a fifth of its rates in sim time at RTF 5 and twice them at half pace.  Jazzy's
 # MultiThreadedExecutor can spin for tenths of a second of CPU in a tick (rclpy issue
 # 1452); the world holds time for it, and the pace is the one at which every proof keeps
 # its exact set under load (benchmarks/RESULTS.md).  Ticks keep 0.05 s so that a node one
@@ -41,7 +41,7 @@ PLAN_TOLERANCE = 0.25
 # against 5; the tolerance is one), and a control timer that shares the planner's thread
 # loses 0.25 s or more of it to the planner.  The plan period needs a second plan, 10 s
 # later: the hidden run watches to LONG_END_AT at LONG_RTF, ticks of 0.1 s (the /clock
-# rate is the exercise's 80 Hz): it judges only the cruise speed and the plans' times,
+# rate is the exercise's 100 Hz): it judges only the cruise speed and the plans' times,
 # which fall on ticks (the planner's timer and sleep_for start and end on them), so the
 # intervals measure 10.0 s exactly; a 10 Hz timer runs once a tick there.  (One public
 # run of 22.5 s for both plans would keep `check` waiting for both: each second at half
@@ -49,7 +49,7 @@ PLAN_TOLERANCE = 0.25
 SWITCH_AT = 11.75
 END_AT = 12.25
 LONG_END_AT = 22.5
-LONG_RTF = 8.0
+LONG_RTF = 10.0
 OTHER_RTF = 0.5
 # Discovery may cost the first messages: the window opens this long after the first one.
 SETTLE = 0.5

@@ -1,6 +1,6 @@
 """Hidden tests: started with -p cruise_speed:=0.35, the node is watched for two plans.
 
-One run: 22.5 s of simulation time from the node's start, at eight times real time
+One run: 22.5 s of simulation time from the node's start, at ten times real time
 (helpers.LONG_RTF): ticks of 0.1 s, on which the plans fall; half a second of it, before
 the first plan, at half pace.
 """

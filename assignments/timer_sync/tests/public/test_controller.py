@@ -1,6 +1,6 @@
 """Public tests: a 10 Hz control loop, 1 Hz status and the first plan, in simulation time.
 
-One run: 11.75 s of simulation time at four times real time, then 0.5 s at half real time,
+One run: 11.75 s of simulation time at five times real time, then 0.5 s at half real time,
 the first planner run in it.  The plan period (a second plan, 10 s later) is a hidden test.
 """
 
