@@ -36,6 +36,7 @@ import socket
 import subprocess
 import sys
 import threading
+import time
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from typing import Any
 
@@ -58,6 +59,10 @@ STARTUP_VARIABLES = (
 )
 MAX_MESSAGE = 1 << 20
 PR_SET_CHILD_SUBREAPER = 36
+# Wall seconds between two looks at the zygote while the grader waits for it: one stopped
+# (SIGSTOP, or left stopped by a tracer that has gone) is woken, one held by a tracer is
+# given up (see :meth:`Zygote._tend`).
+LOOK_EVERY = 0.05
 
 
 # -- the zygote ----------------------------------------------------------------------
@@ -363,7 +368,7 @@ class Zygote:
     def status(self, pid: int, timeout: float | None) -> int | None:
         """The exit status (as ``Popen.returncode``) of ``pid``, waiting up to ``timeout``."""
         with self._lock:
-            self._lock.wait_for(lambda: pid in self._statuses or not self._alive, timeout)
+            self._wait(lambda: pid in self._statuses or not self._alive, timeout)
             if pid in self._statuses:
                 return self._statuses[pid]
             if self._alive:
@@ -372,9 +377,46 @@ class Zygote:
 
     def _reply(self, timeout: float) -> dict:
         with self._lock:
-            if not self._lock.wait_for(lambda: self._replies or not self._alive, timeout):
+            if not self._wait(lambda: bool(self._replies) or not self._alive, timeout):
+                # No answer in time: it is not asked again, so that a late answer cannot be
+                # taken for the next request's.
+                self._give_up()
                 return {}
             return self._replies.pop(0) if self._replies else {}
+
+    def _wait(self, done: Callable[[], bool], timeout: float | None) -> bool:
+        """Wait, with ``_lock`` held, until ``done()`` or ``timeout``, looking after the
+        zygote every :data:`LOOK_EVERY` seconds meanwhile; whether it is done."""
+        end = None if timeout is None else time.monotonic() + timeout
+        while not done():
+            left = None if end is None else end - time.monotonic()
+            if left is not None and left <= 0:
+                return False
+            if self._lock.wait_for(done, LOOK_EVERY if left is None else min(LOOK_EVERY, left)):
+                return True
+            self._tend()
+        return True
+
+    def _tend(self) -> None:
+        """A program of the student's user can stop or trace the zygote where that user is
+        the grader's (basic isolation): it then answers nothing, and every launch would wait
+        for its timeout.  Stopped (``T``: by SIGSTOP, or left so by a tracer that has gone),
+        it is woken; held by a tracer that is still there (``t``), it is killed, so that its
+        programs and the next launches go on without it (as when it dies)."""
+        state = process_state(self.process.pid)
+        if state == b"T":
+            with contextlib.suppress(OSError):
+                os.kill(self.process.pid, signal.SIGCONT)
+        elif state == b"t":
+            self._give_up()
+
+    def _give_up(self) -> None:
+        """With ``_lock`` held: kill the zygote and go on as if it had died (its programs
+        are waited for by their pids, later launches are exec'd)."""
+        with contextlib.suppress(OSError):
+            self.process.kill()
+        self._alive = False
+        self._lock.notify_all()
 
     def _read(self) -> None:
         try:
@@ -403,19 +445,23 @@ class Zygote:
 
 def _orphan_status(pid: int, timeout: float | None) -> int | None:
     """A program whose zygote died: -SIGKILL once it is gone, None while it runs."""
-    import time
-
     end = None if timeout is None else time.monotonic() + timeout
     while True:
-        try:
-            with open(f"/proc/{pid}/stat", "rb") as fh:  # a zombie nobody reaps is gone too
-                if fh.read().rpartition(b")")[2].split()[0] == b"Z":
-                    return -signal.SIGKILL
-        except (OSError, IndexError):
+        if process_state(pid) in (None, b"Z"):  # a zombie nobody reaps is gone too
             return -signal.SIGKILL
         if end is not None and time.monotonic() >= end:
             return None
         time.sleep(0.01)
+
+
+def process_state(pid: int) -> bytes | None:
+    """The state letter of ``pid`` in ``/proc`` (``R``, ``S``, ``T``, ``t``, ``Z``...), or
+    None once it is gone."""
+    try:
+        with open(f"/proc/{pid}/stat", "rb") as fh:
+            return fh.read().rpartition(b")")[2].split()[0]
+    except (OSError, IndexError):
+        return None
 
 
 if __name__ == "__main__":

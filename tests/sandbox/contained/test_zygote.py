@@ -12,6 +12,8 @@ from __future__ import annotations
 import os
 import re
 import signal
+import subprocess
+import sys
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -20,7 +22,7 @@ import pytest
 
 from autograder.core.exercise import Limits
 from autograder.sandbox import process as process_module
-from autograder.sandbox.contained.zygote import ForkedProcess
+from autograder.sandbox.contained.zygote import ForkedProcess, process_state
 from autograder.sandbox.process import (
     LaunchFailed,
     StudentProcess,
@@ -192,6 +194,103 @@ def test_a_dead_zygote_leaves_its_programs_killed_and_later_ones_execd(
         finally:
             second.stop()
     finally:
+        first.stop()
+
+
+def _sleeper(tmp_path: Path) -> Path:
+    staged = tmp_path / "staged"
+    staged.mkdir()
+    (staged / "prog.py").write_text("import time\nprint('up', flush=True)\ntime.sleep(60)\n")
+    return staged / "prog.py"
+
+
+def _started(script: Path) -> StudentProcess:
+    program = student_process(script, [], Limits(), domain=7, strict=False, course=ROOT)
+    program.start()
+    return program
+
+
+def _says_up(program: StudentProcess) -> bool:
+    """Whether the program printed its first line within WALL seconds."""
+    end = time.monotonic() + WALL
+    while not program.output_text().startswith("up\n"):
+        if time.monotonic() > end:
+            return False
+        time.sleep(0.01)
+    return True
+
+
+def _reaches(pid: int, state: bytes) -> bool:
+    """Whether ``pid`` is in ``state`` (a ``/proc`` state letter) within WALL seconds."""
+    end = time.monotonic() + WALL
+    while process_state(pid) != state:
+        if time.monotonic() > end:
+            return False
+        time.sleep(0.01)
+    return True
+
+
+# Attaches to a pid as a tracer (as tests/submissions/hostile/snoops_processes does) and
+# stays, so the tracee stays stopped.
+TRACER = """\
+import ctypes, sys, time
+attached = ctypes.CDLL(None, use_errno=True).ptrace(16, int(sys.argv[1]), None, None) == 0
+print("attached" if attached else "refused", flush=True)
+time.sleep(600)
+"""
+
+
+@pytest.mark.usefixtures("fresh_zygotes")
+def test_a_stopped_zygote_is_woken_and_forks_the_next_program(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Where the student's user is the grader's (basic isolation), a program can SIGSTOP
+    the zygote, or trace it and end, which leaves it stopped: the next launch wakes it and
+    is forked as before (it waited 30 s for an answer, then was exec'd)."""
+    monkeypatch.setenv("AUTOGRADER_ZYGOTE", "1")
+    script = _sleeper(tmp_path)
+    _started(script).stop()
+    (zygote,) = zygotes()
+    os.kill(zygote.process.pid, signal.SIGSTOP)
+    assert _reaches(zygote.process.pid, b"T")
+    program = _started(script)
+    try:
+        assert isinstance(program.popen, ForkedProcess)
+        assert _says_up(program)
+    finally:
+        program.stop()
+
+
+@pytest.mark.usefixtures("fresh_zygotes")
+def test_a_zygote_held_by_a_tracer_is_given_up_for_exec(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A zygote a tracer holds answers nothing while the tracer stays: the next launch
+    ends it (it waited 30 s for an answer and kept asking it) and is exec'd, and the
+    program it forked before is still the grader's to end."""
+    monkeypatch.setenv("AUTOGRADER_ZYGOTE", "1")
+    script = _sleeper(tmp_path)
+    first = _started(script)
+    (zygote,) = zygotes()
+    tracer = subprocess.Popen([sys.executable, "-c", TRACER, str(zygote.process.pid)],
+                              stdout=subprocess.PIPE, text=True)
+    try:
+        assert tracer.stdout is not None
+        if tracer.stdout.readline().strip() != "attached":
+            pytest.skip("this machine lets no process trace another of its user (Yama)")
+        assert _reaches(zygote.process.pid, b"t")
+        second = _started(script)
+        try:
+            assert not isinstance(second.popen, ForkedProcess)
+            assert _says_up(second)
+            # Killed: a zombie, reaped once its tracer lets it go.
+            assert _reaches(zygote.process.pid, b"Z")
+        finally:
+            second.stop()
+        assert first.wait(0.5) is None
+        first.signal(signal.SIGKILL)
+        assert first.wait(WALL) == -signal.SIGKILL
+    finally:
+        tracer.kill()
+        tracer.wait()
         first.stop()
 
 
