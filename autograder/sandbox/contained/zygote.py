@@ -63,6 +63,8 @@ PR_SET_CHILD_SUBREAPER = 36
 # (SIGSTOP, or left stopped by a tracer that has gone) is woken, one held by a tracer is
 # given up (see :meth:`Zygote._tend`).
 LOOK_EVERY = 0.05
+# Wall seconds a closed server (the zygote, the template) has to end before it is killed.
+CLOSE_WITHIN = 5.0
 
 
 # -- the zygote ----------------------------------------------------------------------
@@ -218,15 +220,19 @@ def start_server(command: Sequence[str], env: Mapping[str, str],
 
 def close_server(sock: socket.socket, process: subprocess.Popen[Any]) -> None:
     """Close a forking server's socket (it then ends) and wait for it, killed if it has
-    not ended within 5 s."""
+    not ended within :data:`CLOSE_WITHIN` seconds, and then waited for as long again at
+    most: a process a tracer holds (a program of the grader's user may trace the zygote in
+    basic isolation) stays a zombie until the tracer lets it go, and the grader does not
+    wait for the student's program."""
     with contextlib.suppress(OSError):
         sock.shutdown(socket.SHUT_RDWR)
     sock.close()
     try:
-        process.wait(5.0)
+        process.wait(CLOSE_WITHIN)
     except subprocess.TimeoutExpired:
         process.kill()
-        process.wait()
+        with contextlib.suppress(subprocess.TimeoutExpired):
+            process.wait(CLOSE_WITHIN)
 
 
 def _reap(sock: socket.socket) -> None:

@@ -14,6 +14,7 @@ import re
 import signal
 import subprocess
 import sys
+import threading
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -22,6 +23,7 @@ import pytest
 
 from autograder.core.exercise import Limits
 from autograder.sandbox import process as process_module
+from autograder.sandbox.contained import zygote as zygote_module
 from autograder.sandbox.contained.zygote import ForkedProcess, process_state
 from autograder.sandbox.process import (
     LaunchFailed,
@@ -264,8 +266,9 @@ def test_a_stopped_zygote_is_woken_and_forks_the_next_program(
 def test_a_zygote_held_by_a_tracer_is_given_up_for_exec(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """A zygote a tracer holds answers nothing while the tracer stays: the next launch
-    ends it (it waited 30 s for an answer and kept asking it) and is exec'd, and the
-    program it forked before is still the grader's to end."""
+    ends it (it waited 30 s for an answer and kept asking it) and is exec'd, the program
+    it forked before is still the grader's to end, and ending the zygotes does not wait
+    for the tracer to let the dead one go (it waited as long as the tracer stayed)."""
     monkeypatch.setenv("AUTOGRADER_ZYGOTE", "1")
     script = _sleeper(tmp_path)
     first = _started(script)
@@ -288,6 +291,12 @@ def test_a_zygote_held_by_a_tracer_is_given_up_for_exec(
         assert first.wait(0.5) is None
         first.signal(signal.SIGKILL)
         assert first.wait(WALL) == -signal.SIGKILL
+        # Ending the zygotes (at the child's exit) does not wait for the tracer.
+        monkeypatch.setattr(zygote_module, "CLOSE_WITHIN", 0.2)
+        closing = threading.Thread(target=close_zygotes, daemon=True)
+        closing.start()
+        closing.join(WALL)
+        assert not closing.is_alive()
     finally:
         tracer.kill()
         tracer.wait()
