@@ -159,6 +159,22 @@ def kept_busy(cpu: float, waited: float, wall: float) -> bool:
     return cpu >= max(BUSY_CPU_SECONDS, 0.5 * (wall - waited))
 
 
+def stall_cap(sim_timeout: float, pace: float) -> float:
+    """Wall seconds after which a wait for ``sim_timeout`` of simulation time counts as a
+    stalled world: STALL_FACTOR times the wall time the wait takes at ``pace`` (sim seconds
+    per wall second; 0: as fast as the graph keeps up) or at real time, whichever is
+    longer, and at least MIN_STALL_SECONDS. A pace below real time stretches the cap with
+    it: at half pace a wait of 3 s takes 6 s before any hold, and four times that leaves
+    the holds of a loaded machine as much room as at real time."""
+    slowest = sim_timeout / pace if 0.0 < pace < 1.0 else sim_timeout
+    return max(MIN_STALL_SECONDS, STALL_FACTOR * slowest)
+
+
+STALL_FACTOR = 4.0
+"""How many times the wall time a wait takes at its pace (or at real time, if faster) a
+world may take before the wait counts as stalled."""
+MIN_STALL_SECONDS = 10.0
+"""The least wall time any wait is given before it counts as stalled."""
 BUSY_CPU_SECONDS = 0.5
 """The least CPU a node must have used in a stalled wait to be what stalled it."""
 TALLY_EVERY = 0.25
@@ -227,12 +243,13 @@ class Probe:
                  wall_timeout: float | None = None) -> bool:
         """True once ``condition()`` holds, False when ``sim_timeout`` of sim time passed.
 
-        The wall cap (default: 4 times the sim timeout, at least 10 s) only ends waits on a
-        world that stopped advancing; it raises, as that is no verdict on a sim-time
-        condition: the student's failure if its node kept the CPU busy meanwhile (the world
-        holds ticks for it), else the grader's (:func:`kept_busy`).
+        The wall cap (default: :func:`stall_cap` at the world's pace as the wait begins)
+        only ends waits on a world that stopped advancing; it raises, as that is no verdict
+        on a sim-time condition: the student's failure if its node kept the CPU busy
+        meanwhile (the world holds ticks for it), else the grader's (:func:`kept_busy`).
         """
-        wall = wall_timeout if wall_timeout is not None else max(10.0, 4.0 * sim_timeout)
+        wall = wall_timeout if wall_timeout is not None else stall_cap(
+            sim_timeout, float(getattr(self.world, "real_time_factor", 0.0)))
         start = self.now
 
         def elapsed() -> bool:  # sim time is steps * dt: 12.4 - 12.3 may be 0.0999...

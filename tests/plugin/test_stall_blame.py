@@ -1,7 +1,7 @@
-"""Whose failure a stalled wait is: the program's if it (its node, or any process it
-started) kept the CPU busy, else the machine's."""
+"""When a wait counts as stalled, and whose failure a stalled wait is: the program's if
+it (its node, or any process it started) kept the CPU busy, else the machine's."""
 
-from autograder.plugin.probe import kept_busy
+from autograder.plugin.probe import kept_busy, stall_cap
 
 
 def test_a_busy_loop_is_blamed_even_on_a_loaded_machine():
@@ -33,3 +33,20 @@ def test_children_spinning_to_starve_the_world_are_the_programs_doing():
 
 def test_nothing_watched_is_never_the_node():
     assert not kept_busy(0.0, 0.0, 12.0)
+
+
+# How long a wait may take before it counts as stalled.
+
+def test_a_wait_at_real_time_or_faster_is_given_four_times_its_sim_time():
+    assert stall_cap(3.0, 1.0) == stall_cap(3.0, 4.0) == stall_cap(3.0, 0.0) == 12.0
+
+
+def test_a_wait_below_real_time_is_given_four_times_what_its_pace_takes():
+    """At half pace a 3 s wait takes 6 s before any hold: a cap of 12 s left a loaded
+    machine's holds only 6 s, and the callback_groups proof met a grader error there."""
+    assert stall_cap(3.0, 0.5) == 4 * 3.0 / 0.5
+    assert stall_cap(1.0, 0.05) == 4 * 1.0 / 0.05
+
+
+def test_a_short_wait_is_given_at_least_ten_seconds():
+    assert stall_cap(0.5, 1.0) == stall_cap(0.5, 0.5) == 10.0
