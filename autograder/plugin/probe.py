@@ -272,17 +272,22 @@ class Probe:
             return True
         if not done and not elapsed():
             took = time.monotonic() - began
+            # How far it got says how stalled it was: not at all, or only too slowly.
+            progress = {"seconds": took, "advanced": max(0.0, self.now - start),
+                        "needed": sim_timeout}
             if tally is not None:
                 tally.read()
             if tally is not None and not kept_busy(tally.cpu_seconds, tally.waited_seconds,
                                                    tally.span_seconds):
                 raise GraderError(
-                    _("The simulation could not advance for {seconds:.0f} s of wall time, and "
-                      "the node was not what kept it busy: the machine was too busy to grade. "
-                      "Grade again on a quieter machine.").format(seconds=took))
+                    _("In {seconds:.0f} s of wall time the simulation advanced {advanced:.2f} s "
+                      "of the {needed:.1f} s this wait needed, and the node was not what kept "
+                      "it busy: the machine was too busy to grade. Grade again on a quieter "
+                      "machine.").format(**progress))
             raise StudentFailure(
-                _("The simulation could not advance for {seconds:.0f} s of wall time: the "
-                  "node kept the machine too busy.").format(seconds=wall),
+                _("In {seconds:.0f} s of wall time the simulation advanced {advanced:.2f} s of "
+                  "the {needed:.1f} s this wait needed: the node kept the machine too "
+                  "busy.").format(**progress),
                 _("Look for busy loops; use timers and callbacks instead of while loops."))
         return False
 

@@ -326,5 +326,9 @@ def test_children_that_starve_the_world_fail_the_program_not_the_machine(prefix)
         assert results["grader_error"] is None, done.stdout[-3000:] + done.stderr[-3000:]
         assert done.returncode == 0
         assert results["score"] <= 1  # the node starts; it never answers
+        stalled = [t["message"] for t in results["tests"]
+                   if "the node kept the machine too busy" in (t.get("message") or "")]
+        assert stalled, results["tests"]  # and the message says how far it got
+        assert all("the simulation advanced" in message for message in stalled)
     finally:
         shutil.rmtree(work, ignore_errors=True)
