@@ -86,6 +86,15 @@ def _middleware_thread(stat: bytes) -> bool:
     return stat[stat.index(b"(") + 1:stat.rindex(b")")].startswith(MIDDLEWARE_THREADS)
 
 
+def process_state(pid: int) -> bytes | None:
+    """The state letter of process ``pid`` (``R``, ``S``, ``D``, ``T``, ``t``, ``Z``...,
+    its main thread's), or None once it is gone."""
+    try:
+        return _thread_state(_read_file(f"/proc/{pid}/stat", 4096)) or None
+    except (OSError, ValueError):
+        return None
+
+
 def thread_busy(tid: int) -> bool:
     """True if thread ``tid`` of this process is running or waits for a CPU; False if it
     sleeps or is gone."""

@@ -33,6 +33,7 @@ from autograder.sandbox.domains import DomainLock
 from autograder.sandbox.isolation import Isolation, run_prefix, student_uid
 from autograder.sandbox.process import reap_recorded
 from autograder.sandbox.sweep import sweep_user
+from sim.procstate import process_state
 
 Progress = Callable[[RawTest], None]
 Process = subprocess.Popen[bytes] | ForkedChild
@@ -270,11 +271,7 @@ def wait(children: Sequence[Child], limit: float, watchers: Watchers,
 
 def _stopped(pid: int) -> bool:
     """Whether process ``pid`` is stopped (``T``) or held by a tracer (``t``)."""
-    try:
-        with open(f"/proc/{pid}/stat", "rb") as fh:
-            return fh.read().rpartition(b")")[2].split()[0] in (b"T", b"t")
-    except (OSError, IndexError):
-        return False
+    return process_state(pid) in (b"T", b"t")
 
 
 def _tell(children: Sequence[Child], reported: set[str], watchers: Watchers) -> list[RawTest]:

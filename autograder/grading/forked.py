@@ -27,6 +27,7 @@ from typing import Any
 
 from autograder.grading.template import MAX_MESSAGE
 from autograder.sandbox.contained.zygote import close_server, start_server
+from sim.procstate import process_state
 
 SWITCH = "AUTOGRADER_CHILD_TEMPLATE"  # "0": every child pytest is exec'd
 # Read once per forked child: the bytecode cache (bytecode_env in children.py).
@@ -132,11 +133,7 @@ class ForkedChild:
 
 def _gone(pid: int) -> bool:
     """Whether process ``pid`` has ended (a zombie nobody reaps has too)."""
-    try:
-        with open(f"/proc/{pid}/stat", "rb") as fh:
-            return fh.read().rpartition(b")")[2].split()[0] == b"Z"
-    except (OSError, IndexError):
-        return True
+    return process_state(pid) in (None, b"Z")
 
 
 class Template:

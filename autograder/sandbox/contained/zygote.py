@@ -42,6 +42,7 @@ from typing import Any
 
 from autograder.sandbox.contained.launcher import LAUNCH_FAILED, contain
 from autograder.sandbox.contained.runner import run_program
+from sim.procstate import process_state
 
 # What students' nodes import (the chapter's exercises and the book's code): imported once
 # here instead of in every program.  A missing one is skipped.
@@ -458,16 +459,6 @@ def _orphan_status(pid: int, timeout: float | None) -> int | None:
         if end is not None and time.monotonic() >= end:
             return None
         time.sleep(0.01)
-
-
-def process_state(pid: int) -> bytes | None:
-    """The state letter of ``pid`` in ``/proc`` (``R``, ``S``, ``T``, ``t``, ``Z``...), or
-    None once it is gone."""
-    try:
-        with open(f"/proc/{pid}/stat", "rb") as fh:
-            return fh.read().rpartition(b")")[2].split()[0]
-    except (OSError, IndexError):
-        return None
 
 
 if __name__ == "__main__":

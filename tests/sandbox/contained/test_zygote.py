@@ -16,7 +16,7 @@ import subprocess
 import sys
 import threading
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
@@ -24,7 +24,7 @@ import pytest
 from autograder.core.exercise import Limits
 from autograder.sandbox import process as process_module
 from autograder.sandbox.contained import zygote as zygote_module
-from autograder.sandbox.contained.zygote import ForkedProcess, process_state
+from autograder.sandbox.contained.zygote import ForkedProcess
 from autograder.sandbox.process import (
     LaunchFailed,
     StudentProcess,
@@ -32,6 +32,7 @@ from autograder.sandbox.process import (
     student_process,
     zygotes,
 )
+from sim.procstate import process_state
 
 ROOT = Path(__file__).resolve().parents[3]
 # Wall seconds a program may take to start or to end: generous, for a loaded machine (a
@@ -212,24 +213,24 @@ def _started(script: Path) -> StudentProcess:
     return program
 
 
-def _says_up(program: StudentProcess) -> bool:
-    """Whether the program printed its first line within WALL seconds."""
+def _within(condition: Callable[[], bool]) -> bool:
+    """Whether ``condition()`` holds within WALL seconds."""
     end = time.monotonic() + WALL
-    while not program.output_text().startswith("up\n"):
+    while not condition():
         if time.monotonic() > end:
             return False
         time.sleep(0.01)
     return True
+
+
+def _says_up(program: StudentProcess) -> bool:
+    """Whether the program printed its first line within WALL seconds."""
+    return _within(lambda: program.output_text().startswith("up\n"))
 
 
 def _reaches(pid: int, state: bytes) -> bool:
     """Whether ``pid`` is in ``state`` (a ``/proc`` state letter) within WALL seconds."""
-    end = time.monotonic() + WALL
-    while process_state(pid) != state:
-        if time.monotonic() > end:
-            return False
-        time.sleep(0.01)
-    return True
+    return _within(lambda: process_state(pid) == state)
 
 
 # Attaches to a pid as a tracer (as tests/submissions/hostile/snoops_processes does) and
