@@ -15,6 +15,7 @@ from typing import Any
 
 from autograder.core.errors import StudentFailure
 from autograder.i18n import _
+from autograder.plugin.probe import stall_cap
 
 CONTROL_HZ = 10.0
 STATUS_PERIOD = 1.0
@@ -105,8 +106,9 @@ class Run:
         return [t for t, _m in self.plans if self.start <= t < self.end]
 
 
-def _watch(probe, streams: Streams, seconds: float, wall_factor: float) -> float | None:
-    """Let ``seconds`` of sim time pass; the time cmd_vel froze at, if it went silent."""
+def _watch(probe, streams: Streams, seconds: float, slowest: float) -> float | None:
+    """Let ``seconds`` of sim time pass, at paces no slower than ``slowest`` (the world
+    changes pace itself meanwhile); the time cmd_vel froze at, if it went silent."""
     end = probe.now + seconds
     while probe.now < end:
         times = streams.commands.times
@@ -116,7 +118,7 @@ def _watch(probe, streams: Streams, seconds: float, wall_factor: float) -> float
         chunk = min(1.0, end - probe.now)
         target = probe.now + chunk
         probe.wait_for(lambda t=target: probe.now >= t, chunk + 0.5,
-                       wall_timeout=max(10.0, wall_factor * 4 * chunk))
+                       wall_timeout=stall_cap(chunk, slowest))
     return None
 
 
@@ -148,7 +150,7 @@ def observe(probe, world, streams: Streams, end_at: float = END_AT,
     try:
         start = max(streams.started, commands.times[0]) + SETTLE
         probe.wait_for(lambda: probe.now >= start, SETTLE + 1.0)
-        frozen = _watch(probe, streams, end - probe.now, max(1.0, 1.0 / slowest))
+        frozen = _watch(probe, streams, end - probe.now, slowest)
     finally:
         world.cancel_scheduled_pace()
         world.set_real_time_factor(pace)
