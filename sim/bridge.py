@@ -26,7 +26,11 @@ Physics runs in one thread and an executor in another (the node serves no parame
 services: another node must not set its ``use_sim_time``); the world is only touched
 under the bridge's lock (the pacer's condition), and waiters are woken on it each tick.
 Taps (:meth:`SimBridge.add_tap`, e.g. a :class:`sim.bag.BagRecorder`) see every message
-the bridge publishes or receives, with its simulation time.
+the bridge publishes or receives, with its simulation time.  A grader that stands in for a
+sensor publishes from :meth:`SimBridge.after_each_tick`, in the world's thread, so that
+its messages keep step with ``/clock`` as the lidar's do (a thread of its own can run
+ticks late on a loaded machine), and changes what it publishes in
+:meth:`SimBridge.between_ticks`.
 """
 
 from __future__ import annotations
@@ -40,7 +44,7 @@ import time
 from collections import Counter
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import AbstractContextManager
-from typing import Any
+from typing import Any, TypeVar
 
 from nav_msgs.msg import Odometry
 from rclpy.callback_groups import CallbackGroup
@@ -74,6 +78,9 @@ class _TakenByTheWorld(CallbackGroup):
 
     def ending_execution(self, entity: object) -> None:
         pass
+
+
+T = TypeVar("T")
 
 
 def _stamp(t: float) -> tuple[int, int]:
@@ -113,6 +120,7 @@ class SimBridge:
         self._clock_log: list[tuple[int, float]] = []
         self._threads: list[threading.Thread] = []
         self._taps: list[Callable[[str, str, Any, float], None]] = []
+        self._after_tick: list[Callable[[float], None]] = []
         self._listened: dict[str, object] = {}  # topic -> its subscription (see listen)
         # Pace changes due at a sim time (schedule_real_time_factor), soonest first, and
         # those made so far as (sim time, rtf).
@@ -229,6 +237,28 @@ class SimBridge:
         """Hand every message published or received to ``tap(topic, type name, message,
         sim time)`` (add taps before :meth:`start`; a tap must not raise)."""
         self._taps.append(tap)
+
+    def after_each_tick(self, hook: Callable[[float], None]) -> Callable[[], None]:
+        """Call ``hook(sim time)`` in the world's thread after each tick's messages went out
+        and before the pacing holds for the watched processes, so what it publishes reaches
+        them with that tick's ``/clock``, as the lidar's scans do, however late the caller's
+        threads run.  Return a function that removes the hook (call it before what the hook
+        publishes with is destroyed).  A hook runs under the world's lock: it must be quick,
+        must not raise, and must not wait for sim time."""
+        with self._cond:
+            self._after_tick.append(hook)
+
+        def remove() -> None:
+            with self._cond:
+                if hook in self._after_tick:
+                    self._after_tick.remove(hook)
+        return remove
+
+    def between_ticks(self, action: Callable[[], T]) -> T:
+        """Run ``action()`` while no tick is under way and return what it returns: :attr:`now`
+        stays at the last tick's end throughout, and no tick hook runs meanwhile."""
+        with self._cond:
+            return action()
 
     def listen(self, topic: str, msg_type: type) -> None:
         """Also hand taps what goes out on ``topic``, a topic the world does not use (a
@@ -465,6 +495,8 @@ class SimBridge:
                 scan = self._laser_scan(out.scan)
                 self._scan_pub.publish(scan)
                 self._tap("/scan", scan, out.scan.t)
+        for hook in list(self._after_tick):
+            hook(self.world.time)
         self.pacer.note_tick(self.world.time)
         self._cond.notify_all()
 

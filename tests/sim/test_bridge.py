@@ -358,6 +358,39 @@ def test_student_process_stops_before_wall(tmp_path, graph: tuple[SimBridge, Pro
         student.wait(timeout=WALL)
 
 
+def test_a_hook_runs_in_step_with_every_tick(graph: tuple[SimBridge, Probe]) -> None:
+    """after_each_tick calls its hook in the world's thread once per tick, with the sim time
+    of the /clock that tick just sent (what a grader standing in for a sensor publishes
+    then goes out with that tick), until it is removed; between_ticks runs an action while
+    no tick is under way, so the sim time it reads is the last /clock's, never one a tick
+    has stepped to and not yet published."""
+    bridge, _probe = graph
+    clocks: list[float] = []
+    calls: list[tuple[float, str]] = []
+    bridge.add_tap(lambda topic, _type, _msg, t: clocks.append(t) if topic == "/clock" else None)
+    remove = bridge.after_each_tick(
+        lambda t: calls.append((t, threading.current_thread().name)))
+    assert bridge.wait_for(lambda: len(calls) >= 30, sim_timeout=5.0, wall_timeout=WALL)
+    remove()
+    bridge.pause()  # no tick goes while the two lists are compared
+    try:
+        ended = len(calls)
+        assert [t for t, _thread in calls] == clocks[-ended:]
+        assert {thread for _t, thread in calls} == {"sim-physics"}
+    finally:
+        bridge.resume()
+    assert bridge.wait_until(bridge.now + 0.5, wall_timeout=WALL)
+    assert len(calls) == ended  # removed: no more calls though the world ran on
+
+    def read() -> tuple[float, float]:
+        return bridge.now, clocks[-1]
+
+    start, readings = bridge.now, []
+    while bridge.now < start + 0.5:  # read as often as we can while ticks go on
+        readings.append(bridge.between_ticks(read))
+    assert all(now == last_clock for now, last_clock in readings)
+
+
 def test_inject_says_from_when_messages_show_the_fault(
         graph: tuple[SimBridge, Probe]) -> None:
     """A fault added while a tick is under way (here by a tap, between that tick's /clock
