@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import math
 import re
-import threading
 import time
 from collections.abc import Callable
 from typing import Any
 
 from geometry_msgs.msg import Twist
+from rclpy.time import Time
 from sensor_msgs.msg import LaserScan
 
 from autograder.core.errors import StudentFailure
@@ -60,42 +60,46 @@ CLEAR = make_scan(2.0)
 
 
 class ScanFeeder:
-    """Publishes one scan on /scan every 0.1 s of simulation time, like the lidar would.
+    """Publishes one scan on /scan every 0.1 s of simulation time, as the lidar would.
 
-    The repeats go from the probe's timer, in the probe's thread, which the world does not
-    wait for: on a loaded machine that thread can run ticks late. So a new scan is sent
-    at once, from the caller's thread, when it is fed: a node is judged from a time it
-    could have had the scan (a class of 100 at ``--jobs auto``, eight gradings at once on
-    2 cores, lost a correct node's points when the first send waited for the timer)."""
+    Each goes out from the world's own thread, right after a tick's /clock
+    (``world.after_each_tick``), so the world holds its next tick until the node has taken
+    the scan in, whatever the load. A thread of the grader's own, which the world does not
+    wait for, ran ticks late on a loaded machine: at eight times real time a 0.5 s watchdog
+    is 62 ms of wall time, and a correct node stopped for want of scans (CI, a known-bad
+    variant that lost ``test_drives_when_clear`` as well). A new scan goes out at once,
+    between two ticks, when it is fed: a node is judged from a time it could have had it."""
 
-    def __init__(self, probe: Any) -> None:
+    def __init__(self, probe: Any, world: Any) -> None:
         self.probe = probe
+        self.world = world
         self.scan: LaserScan | None = None
         # Wall time (epoch seconds, as DDS source timestamps) the last scan was sent by.
         self.last_sent_wall: float | None = None
-        self._lock = threading.Lock()  # a scan is sent whole before another is fed
+        self._due = 0.0  # the simulation time the next repeat is due at
         probe.publish(LaserScan, "/scan", CLEAR)  # creates the publisher; nobody listens yet
-        self.timer = probe.node.create_timer(0.1, self._tick)
+        self.close = world.after_each_tick(self._tick)
 
-    def _send(self, scan: LaserScan) -> None:
-        scan.header.stamp = self.probe.node.get_clock().now().to_msg()
+    def _send(self, scan: LaserScan, now: float) -> None:
+        scan.header.stamp = Time(nanoseconds=round(now * 1e9)).to_msg()
         self.probe.publish(LaserScan, "/scan", scan)
         self.last_sent_wall = time.time()  # after the publish: the node got it later
+        self._due = now + 0.1 - 1e-6  # sim time is steps * dt: 0.1 may read 0.0999...
 
-    def _tick(self) -> None:
-        with self._lock:
-            if self.scan is not None:
-                self._send(self.scan)
+    def _tick(self, now: float) -> None:
+        if self.scan is not None and now >= self._due:
+            self._send(self.scan, now)
 
     def feed(self, scan: LaserScan | None) -> float:
         """From now on publish ``scan`` (None: nothing), the first at once; the simulation
         time it changed (nothing else is sent after this returns)."""
-        with self._lock:
+        def change() -> float:
             self.scan = scan
-            changed = self.probe.now
+            now = float(self.world.now)
             if scan is not None:
-                self._send(scan)
-        return changed
+                self._send(scan, now)
+            return now
+        return self.world.between_ticks(change)
 
 
 def is_zero(t: Twist) -> bool:

@@ -39,7 +39,9 @@ pytestmark = pytest.mark.world("empty_room")
 def feeder(world, probe):
     """Silence the world's lidar; the grader's scans are all the node sees."""
     world.inject(Fault(kind="dropout", start=world.now))
-    return ScanFeeder(probe)
+    feeder = ScanFeeder(probe, world)
+    yield feeder
+    feeder.close()  # before the probe, whose publisher it sends with, goes
 
 
 @pytest.fixture
