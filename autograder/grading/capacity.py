@@ -35,8 +35,9 @@ TARGET_LOAD = 2.0
 # of 100 gradings (the pacing took the node's middleware taking a tick in for the node
 # hearing it; fixed since, and twelve error_handling at once then kept 96 of 96); four at
 # once lost none of 100. Kept at two: a class of 100 at up to four a core was only 8 %
-# faster, slower for ai_bridge, and a world took a command seven ticks late
-# (benchmarks/RESULTS.md, 2026-11-28). Measured on 2 cores only.
+# faster, slower for ai_bridge, and a world took a command seven ticks late; at three a
+# core in 22 % less time, every score full, but a command six ticks late, past error_handling's
+# watchdog (benchmarks/RESULTS.md, 2026-11-28). Measured on 2 cores only.
 JOBS_PER_CORE = 2
 # Resident memory of one grading (pytest child, simulator, student node), with room for a
 # node that allocates more than a reference solution does.
