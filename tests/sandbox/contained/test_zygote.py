@@ -385,8 +385,8 @@ def test_a_programs_orphans_are_the_zygotes_to_reap(
     staged.mkdir()
     (staged / "prog.py").write_text(
         "import os, sys, time\n"
+        "parent = os.getpid()  # before the fork: the parent may be gone before the child runs\n"
         "if os.fork() == 0:\n"
-        "    parent = os.getppid()\n"
         "    end = time.monotonic() + 60\n"
         "    while os.getppid() == parent and time.monotonic() < end:\n"
         "        time.sleep(0.01)\n"
